@@ -16,6 +16,8 @@ app = typer.Typer(
 
 # Each module defines register(app) and adds its commands.
 _COMMAND_MODULES = (
+    "activeintent.commands",
+    "activeintent.bench.commands",
     "activeintent.sim.commands",
 )
 

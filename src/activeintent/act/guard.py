@@ -1,0 +1,111 @@
+"""Static allow-list for model-written robot programs (the first sandbox layer).
+
+A program may only use plain Python control flow, functions, comprehensions and the names the
+robot API provides. Everything that can reach the interpreter's internals is refused before the
+program runs: imports, every name or attribute starting with ``_``, introspection builtins,
+frame/generator/code attributes (which need no underscore), ``str.format`` (whose format
+strings can walk attributes), classes, ``global``/``nonlocal``, ``yield``, ``async`` and ``with``.
+The process limits of the sandbox are the second layer for what this cannot see.
+"""
+
+from __future__ import annotations
+
+import ast
+
+MAX_PROGRAM_CHARS = 20_000
+
+ALLOWED_NODES: tuple[type[ast.AST], ...] = (
+    ast.Module, ast.Expr, ast.Assign, ast.AugAssign, ast.For, ast.While, ast.If, ast.Break,
+    ast.Continue, ast.Pass, ast.FunctionDef, ast.Return, ast.arguments, ast.arg, ast.keyword,
+    ast.Name, ast.Load, ast.Store, ast.Del, ast.Delete, ast.Constant, ast.JoinedStr,
+    ast.FormattedValue, ast.List, ast.Tuple, ast.Set, ast.Dict, ast.ListComp, ast.SetComp,
+    ast.DictComp, ast.GeneratorExp, ast.comprehension, ast.BinOp, ast.UnaryOp, ast.BoolOp,
+    ast.Compare, ast.Call, ast.Attribute, ast.Subscript, ast.Slice, ast.Starred, ast.IfExp,
+    ast.Lambda, ast.Assert, ast.Try, ast.ExceptHandler, ast.Raise, ast.NamedExpr,
+    # operators and contexts
+    ast.operator, ast.unaryop, ast.boolop, ast.cmpop, ast.expr_context,
+)
+
+# Builtins and module names that give access to code, files, frames or the interpreter.
+FORBIDDEN_NAMES = frozenset({
+    "exec", "eval", "compile", "open", "getattr", "setattr", "delattr", "hasattr", "globals",
+    "locals", "vars", "dir", "breakpoint", "input", "help", "memoryview", "type", "object",
+    "super", "classmethod", "staticmethod", "property", "id", "exit", "quit", "copyright",
+    "credits", "license", "bytearray", "issubclass", "aiter", "anext",
+    "importlib", "builtins", "os", "sys", "subprocess", "socket", "ctypes", "signal",
+})
+
+# Attributes without an underscore that still lead to frames, code, globals, files or formatting.
+FORBIDDEN_ATTRIBUTES = frozenset({
+    "format", "format_map", "mro", "with_traceback",
+    "gi_frame", "gi_code", "gi_yieldfrom", "gi_running", "gi_suspended",
+    "cr_frame", "cr_code", "cr_await", "cr_origin", "ag_frame", "ag_code", "ag_await",
+    "f_back", "f_globals", "f_locals", "f_builtins", "f_code", "f_trace", "f_lasti",
+    "tb_frame", "tb_next", "co_code", "co_consts", "co_names",
+    "func_globals", "func_code", "func_closure", "func_defaults", "im_func", "im_self",
+    "im_class", "cell_contents",
+    # numpy: file access and raw memory
+    "tofile", "dump", "dumps", "ctypes", "load", "save", "savez", "savetxt", "loadtxt",
+    "fromfile", "genfromtxt", "fromregex", "memmap", "lib", "ctypeslib", "testing", "f2py",
+    "distutils", "compat", "source", "lookfor", "info", "show_config", "DataSource",
+})
+FORBIDDEN_ATTRIBUTE_PREFIXES = ("_", "gi_", "cr_", "ag_", "f_", "tb_", "co_", "func_", "im_")
+
+
+class GuardError(ValueError):
+    """The program uses something the sandbox does not allow (message says what and where)."""
+
+
+def _where(node: ast.AST) -> str:
+    line = getattr(node, "lineno", None)
+    return f" (line {line})" if line else ""
+
+
+def _check_name(name: str, node: ast.AST) -> None:
+    if name != "_" and name.startswith("_"):
+        raise GuardError(f"names starting with '_' are not allowed: {name!r}{_where(node)}")
+    if name in FORBIDDEN_NAMES:
+        raise GuardError(
+            f"{name!r} is not available in robot programs{_where(node)}; "
+            "use only the robot API, np and basic builtins (no imports, no introspection)"
+        )
+
+
+def _check_attribute(attr: str, node: ast.AST) -> None:
+    if attr in FORBIDDEN_ATTRIBUTES or attr.startswith(FORBIDDEN_ATTRIBUTE_PREFIXES):
+        raise GuardError(f"attribute {attr!r} is not allowed{_where(node)}")
+
+
+def check_program(source: str) -> ast.Module:
+    """Parse ``source`` and refuse anything outside the allow-list; return the checked tree."""
+    if not isinstance(source, str):
+        raise GuardError(f"a program must be text, not {type(source).__name__}")
+    if len(source) > MAX_PROGRAM_CHARS:
+        raise GuardError(f"program too long ({len(source)} characters; limit {MAX_PROGRAM_CHARS})")
+    try:
+        tree = ast.parse(source, filename="<program>", mode="exec")
+    except SyntaxError as e:
+        raise GuardError(f"syntax error on line {e.lineno}: {e.msg}") from None
+    except (ValueError, RecursionError, MemoryError) as e:  # null bytes, absurd nesting
+        raise GuardError(f"program cannot be parsed: {type(e).__name__}") from None
+    for node in ast.walk(tree):
+        if not isinstance(node, ALLOWED_NODES):
+            kind = type(node).__name__
+            hint = " (no imports: the robot API and np are already available)" if "Import" in kind else ""
+            raise GuardError(f"{kind} statements/expressions are not allowed{hint}{_where(node)}")
+        if isinstance(node, ast.Name):
+            _check_name(node.id, node)
+        elif isinstance(node, ast.Attribute):
+            _check_attribute(node.attr, node)
+        elif isinstance(node, (ast.FunctionDef, ast.Lambda)):
+            if isinstance(node, ast.FunctionDef):
+                _check_name(node.name, node)
+            args = node.args
+            for a in [*args.posonlyargs, *args.args, *args.kwonlyargs, args.vararg, args.kwarg]:
+                if a is not None:
+                    _check_name(a.arg, node)
+        elif isinstance(node, ast.keyword) and node.arg is not None:
+            _check_name(node.arg, node)
+        elif isinstance(node, ast.ExceptHandler) and node.name:
+            _check_name(node.name, node)
+    return tree

@@ -1,0 +1,226 @@
+"""The sandbox's worker process (runs in its own interpreter, never in the caller's).
+
+The parent starts it once with ``python -I`` (no environment, an empty temporary working
+directory); it imports numpy and the world model, warms them up, then loops: read a request
+(length-prefixed JSON on stdin), fork a child that runs one program under OS limits, collect
+its result (capped) within the wall-time limit, kill the child's whole process group, reply.
+
+The child, before running untrusted code: starts a new session (own process group), points
+stdin/stdout/stderr at /dev/null, keeps only the result pipe (fd 3), and if it runs as root,
+chroots into an empty read-only directory and drops to ``nobody``; then it sets RLIMIT_CPU, RLIMIT_AS, RLIMIT_FSIZE = 0, RLIMIT_NOFILE = 4 (no new file or socket can
+be opened), RLIMIT_NPROC = 0 (no fork) and RLIMIT_CORE = 0.
+"""
+
+from __future__ import annotations
+
+import ast
+import builtins
+import json
+import os
+import resource
+import select
+import signal
+import struct
+import sys
+import time
+import traceback
+from typing import Any
+
+import numpy as np  # noqa: F401 - imported before forking so that children start warm
+
+from activeintent.act.guard import GuardError, check_program
+from activeintent.act.robot_api import RobotAPI, safe_builtins
+from activeintent.world.state import WorldState
+
+RESULT_FD = 3
+JAIL = os.path.abspath("jail")  # created empty (mode 0555) in the worker's temporary directory
+NOBODY = 65534
+MAX_MESSAGE_CHARS = 500
+
+
+def read_message(stream: Any) -> dict | None:
+    header = stream.read(4)
+    if len(header) < 4:
+        return None
+    (size,) = struct.unpack(">I", header)
+    return json.loads(stream.read(size))
+
+
+def write_message(stream: Any, message: dict) -> None:
+    data = json.dumps(message).encode()
+    stream.write(struct.pack(">I", len(data)) + data)
+    stream.flush()
+
+
+def _vm_bytes() -> int:
+    """This process's current virtual memory size (the child's memory limit starts above it)."""
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmSize:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return 1 << 30
+
+
+def _error(e: BaseException) -> dict:
+    line = None
+    for frame, lineno in traceback.walk_tb(e.__traceback__):
+        if frame.f_code.co_filename == "<program>":
+            line = lineno
+    try:
+        message = str(e)[:MAX_MESSAGE_CHARS]
+    except Exception:  # noqa: BLE001 - a message that cannot even be printed
+        message = "(unprintable)"
+    return {"type": type(e).__name__, "message": message, "line": line}
+
+
+def run_program(source: str, positions: dict, guard: bool) -> dict:
+    """Run one program against a RobotAPI over ``positions``; return what it did, as data."""
+    api = RobotAPI(WorldState(positions=positions))
+    namespace: dict[str, Any] = {}
+    error = None
+    try:
+        tree = check_program(source) if guard else ast.parse(source)
+        code = compile(tree, "<program>", "exec")
+        namespace = api.namespace()
+        namespace["__builtins__"] = safe_builtins(api) if guard else builtins.__dict__
+        exec(code, namespace)  # noqa: S102 - the sandboxed execution itself
+    except GuardError as e:
+        error = {"type": "GuardError", "message": str(e), "line": None}
+    except BaseException as e:  # noqa: BLE001 - MemoryError, RecursionError, anything the program raises
+        error = _error(e)
+    namespace.clear()  # free what the program allocated before serialising the result
+    return {
+        "skills": [s.model_dump() for s in api.skills],
+        "skill_failures": api.skill_failures,
+        "said": api.said,
+        "error": error,
+    }
+
+
+def _confine(limits: dict, vm_bytes: int) -> None:
+    os.setsid()
+    devnull = os.open(os.devnull, os.O_RDWR)
+    for fd in (0, 1, 2):
+        os.dup2(devnull, fd)
+    os.closerange(RESULT_FD + 1, 1 << 16)
+    if os.getuid() == 0:
+        # An empty, read-only root: even code that got past the allow-list sees no files.
+        os.chroot(JAIL)
+        os.chdir("/")
+        os.setgroups([])
+        os.setgid(NOBODY)
+        os.setuid(NOBODY)
+    cpu = int(limits["cpu_seconds"])
+    memory = vm_bytes + int(limits["memory_mb"]) * (1 << 20)
+    resource.setrlimit(resource.RLIMIT_CPU, (cpu, cpu + 1))
+    resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+    resource.setrlimit(resource.RLIMIT_FSIZE, (0, 0))
+    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+    resource.setrlimit(resource.RLIMIT_NOFILE, (RESULT_FD + 1, RESULT_FD + 1))
+    resource.setrlimit(resource.RLIMIT_NPROC, (0, 0))
+
+
+def _child(request: dict, write_fd: int, vm_bytes: int) -> None:
+    os.dup2(write_fd, RESULT_FD)
+    _confine(request["limits"], vm_bytes)
+    result = run_program(request["program"], request["positions"], request.get("guard", True))
+    data = json.dumps(result).encode()
+    cap = int(request["limits"]["max_output_bytes"])
+    if len(data) > cap:
+        data = json.dumps({
+            "skills": [], "skill_failures": [], "said": [],
+            "error": {"type": "OutputLimit", "message": f"result larger than {cap} bytes", "line": None},
+        }).encode()
+    view = memoryview(data)
+    while view:
+        view = view[os.write(RESULT_FD, view):]
+
+
+def _describe_exit(status: int, timed_out: bool, too_big: bool, limits: dict) -> tuple[str, str]:
+    if timed_out:
+        return "wall", f"wall-time limit of {limits['wall_seconds']} s exceeded; the program was killed"
+    if too_big:
+        return "output", f"output larger than {limits['max_output_bytes']} bytes; the program was killed"
+    if os.WIFSIGNALED(status):
+        sig = os.WTERMSIG(status)
+        if sig in (signal.SIGXCPU, signal.SIGKILL):
+            return "cpu", f"CPU-time limit of {limits['cpu_seconds']} s exceeded; the program was killed"
+        name = signal.Signals(sig).name
+        return "crash", f"the program crashed ({name}), most likely by exceeding the memory limit"
+    return "crash", f"the program ended without a result (exit code {os.WEXITSTATUS(status)})"
+
+
+def handle(request: dict, vm_bytes: int) -> dict:
+    limits = request["limits"]
+    read_fd, write_fd = os.pipe()
+    started = time.perf_counter()
+    pid = os.fork()
+    if pid == 0:  # child: never returns
+        try:
+            os.close(read_fd)
+            _child(request, write_fd, vm_bytes)
+        except BaseException:  # noqa: BLE001 - confinement failed: report no result
+            os._exit(70)
+        os._exit(0)
+    os.close(write_fd)
+    deadline = time.monotonic() + float(limits["wall_seconds"])
+    cap = int(limits["max_output_bytes"]) + 1024
+    chunks: list[bytes] = []
+    size, timed_out, too_big = 0, False, False
+    while True:
+        remaining = deadline - time.monotonic()
+        ready = select.select([read_fd], [], [], max(0.0, remaining))[0] if remaining > 0 else []
+        if not ready:
+            timed_out = True
+            break
+        data = os.read(read_fd, 1 << 16)
+        if not data:
+            break
+        size += len(data)
+        if size > cap:
+            too_big = True
+            break
+        chunks.append(data)
+    os.close(read_fd)
+    # Wait (without reaping) until the child exits or the deadline passes, then kill its group.
+    if not (timed_out or too_big):
+        while os.waitid(os.P_PID, pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is None:
+            if time.monotonic() >= deadline:
+                timed_out = True
+                break
+            time.sleep(0.0005)
+    try:
+        os.killpg(pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+    _, status = os.waitpid(pid, 0)
+    elapsed = time.perf_counter() - started
+    raw = b"".join(chunks)
+    if raw and not too_big and os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0:
+        return {"status": "done", "result": raw.decode("utf-8", "replace"), "elapsed_s": elapsed}
+    kind, message = _describe_exit(status, timed_out, too_big, limits)
+    return {"status": "killed", "kind": kind, "message": message, "elapsed_s": elapsed}
+
+
+def main() -> None:
+    os.mkdir(JAIL, 0o555)
+    stdin, stdout = sys.stdin.buffer, sys.stdout.buffer
+    sys.stdout = sys.stderr  # nothing but protocol messages may reach the parent's pipe
+    # Warm up every code path a program may touch, so children import nothing after forking.
+    run_program(
+        "p = get_obj_pos('red block')\nput_first_on_second('red block', 'blue bowl')\n"
+        "put_first_on_second('red block', p + np.array([0.1, 0.0]))\nsay(f'{np.linalg.norm(p):.2f}')\n"
+        "parse_position('10cm left of the blue bowl')\n",
+        {"red block": (0.0, -0.5, 0.02), "blue bowl": (0.1, -0.6, 0.0), "green block": (-0.1, -0.4, 0.02)},
+        True,
+    )
+    write_message(stdout, {"ready": True, "pid": os.getpid()})
+    while (request := read_message(stdin)) is not None:
+        write_message(stdout, handle(request, _vm_bytes()))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,1 @@
+"""Benchmark: runs every (method, intention, trial) episode, resumable; reports and plots."""

@@ -1,0 +1,1 @@
+"""Intention library: predicates over world states, per-step violation, feasible scenes."""

@@ -1,0 +1,180 @@
+"""Intentions about blocks and bowls: colour match / mismatch (paper), one bowl, one block
+per bowl, next to the same-colour bowl."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from activeintent.intentions.blockwise import BlockwiseIntention
+from activeintent.intentions.placement import free_spot, on_table
+from activeintent.world import COLOR_NAMES, PutIn, PutNextTo, Relations, Scene, Skill, WorldState, relations
+from activeintent.world.predict import apply_skill
+from activeintent.world.scene import color_of
+
+
+def _colors(rng: np.random.Generator, n: int, exclude: tuple[str, ...] | list[str] = ()) -> list[str]:
+    pool = [c for c in COLOR_NAMES if c not in exclude]
+    return [str(c) for c in rng.choice(pool, size=n, replace=False)]
+
+
+def _own_bowl(block: str) -> str:
+    return f"{color_of(block)} bowl"
+
+
+def _blocks_in(rel: Relations, bowl: str) -> list[str]:
+    return [a for a, w in rel.inside if w == bowl]
+
+
+class ColorMatch(BlockwiseIntention):
+    name = "color-match"
+    description = "Put each block in the bowl of the same colour."
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        return rel.in_bowl(block) == _own_bowl(block)
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        return PutIn(block=block, bowl=_own_bowl(block)) if _own_bowl(block) in state.positions else None
+
+    def feasible(self, scene: Scene) -> bool:
+        return len(scene.blocks) >= 1 and all(_own_bowl(b) in scene.bowls for b in scene.blocks)
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        colors = _colors(rng, 2 + int(rng.integers(0, 2)))  # 2 matching pairs (+ a distractor bowl)
+        blocks, bowls = colors[:2], colors
+        return Scene(objects=[f"{c} block" for c in blocks] + [f"{c} bowl" for c in bowls])
+
+
+class ColorMismatch(BlockwiseIntention):
+    name = "color-mismatch"
+    description = "Put each block in a bowl of a different colour from the block."
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        bowl = rel.in_bowl(block)
+        return bowl is not None and color_of(bowl) != color_of(block)
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        options = [w for w in state.bowls if color_of(w) != color_of(block)]
+        if not options:
+            return None
+        # Spread blocks over the bowls; prefer a bowl whose colour matches some block (the
+        # contrast with colour matching is then visible).
+        block_colors = {color_of(b) for b in state.blocks}
+        best = min(options, key=lambda w: (len(_blocks_in(rel, w)), color_of(w) not in block_colors))
+        return PutIn(block=block, bowl=best)
+
+    def feasible(self, scene: Scene) -> bool:
+        return len(scene.blocks) >= 1 and all(
+            any(color_of(w) != color_of(b) for w in scene.bowls) for b in scene.blocks
+        )
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        if rng.random() < 0.5:  # two blocks and the two bowls of their colours: swap them
+            colors = _colors(rng, 2 + int(rng.integers(0, 2)))
+            blocks, bowls = colors[:2], colors
+        else:  # three blocks, bowls of two of their colours
+            blocks = _colors(rng, 3)
+            bowls = blocks[:2]
+        return Scene(objects=[f"{c} block" for c in blocks] + [f"{c} bowl" for c in bowls])
+
+
+def _majority_bowl(state: WorldState, rel: Relations) -> str | None:
+    """The bowl holding the most blocks (ties: first in the state), None without bowls."""
+    if not state.bowls:
+        return None
+    return max(state.bowls, key=lambda w: (len(_blocks_in(rel, w)), -state.bowls.index(w)))
+
+
+class OneBowl(BlockwiseIntention):
+    name = "one-bowl"
+    description = "Put all the blocks together in one bowl (any bowl)."
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        target = _majority_bowl(state, rel)
+        return target is not None and rel.in_bowl(block) == target
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        target = _majority_bowl(state, rel)
+        return PutIn(block=block, bowl=target) if target else None
+
+    def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
+        if self.score(after) < self.score(before) - 1e-9:
+            return True
+        rel_b, rel_a = relations(before), relations(after)
+        bowl = rel_a.in_bowl(step.block)
+        if bowl is None:
+            return True
+        # Starting a second bowl while another one already holds blocks moves away.
+        used = {w for a, w in rel_b.inside if a != step.block}
+        return bool(used) and bowl not in used
+
+    def feasible(self, scene: Scene) -> bool:
+        return len(scene.blocks) >= 2 and len(scene.bowls) >= 1
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_blocks = 2 + int(rng.integers(0, 2))
+        n_bowls = 1 + int(rng.integers(0, 2))
+        colors = _colors(rng, n_blocks + n_bowls)
+        return Scene(
+            objects=[f"{c} block" for c in colors[:n_blocks]] + [f"{c} bowl" for c in colors[n_blocks:]]
+        )
+
+
+class OneBlockPerBowl(BlockwiseIntention):
+    name = "one-block-per-bowl"
+    description = "Put each block alone in its own bowl, whatever the colours."
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        bowl = rel.in_bowl(block)
+        return bowl is not None and _blocks_in(rel, bowl) == [block]
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        empty = [w for w in state.bowls if not _blocks_in(rel, w)]
+        if not empty:
+            return None
+        here = state.pos(block)[:2]
+        best = min(empty, key=lambda w: float(np.hypot(*(state.pos(w)[:2] - here))))
+        return PutIn(block=block, bowl=best)
+
+    def feasible(self, scene: Scene) -> bool:
+        return len(scene.blocks) >= 1 and len(scene.bowls) >= len(scene.blocks)
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_bowls = 2 + int(rng.integers(0, 2))
+        blocks = _colors(rng, 2)
+        bowls = _colors(rng, n_bowls)  # colours drawn independently: matches are a coincidence
+        return Scene(objects=[f"{c} block" for c in blocks] + [f"{c} bowl" for c in bowls])
+
+
+class NextToSameColorBowl(BlockwiseIntention):
+    name = "next-to-same-color-bowl"
+    description = "Put each block on the table next to (not in) the bowl of its own colour."
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        bowl = _own_bowl(block)
+        return bowl in state.positions and on_table(rel, block) and rel.is_next_to(block, bowl)
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        bowl = _own_bowl(block)
+        if bowl not in state.positions:
+            return None
+
+        def ok(after: WorldState) -> bool:
+            return self.wanted(after, relations(after), block)
+
+        step = PutNextTo(block=block, target=bowl, side="nearest")
+        after, failure = apply_skill(state, step)
+        if failure is None and ok(after):
+            return step
+        centre = state.pos(bowl)[:2]
+        ring = [
+            (float(centre[0] + r * np.cos(a)), float(centre[1] + r * np.sin(a)))
+            for r in (0.1, 0.115)
+            for a in np.linspace(0, 2 * np.pi, 24, endpoint=False)
+        ]
+        return free_spot(state, block, ring, accept=ok)
+
+    def feasible(self, scene: Scene) -> bool:
+        return len(scene.blocks) >= 1 and all(_own_bowl(b) in scene.bowls for b in scene.blocks)
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        return ColorMatch().sample_scene(rng)

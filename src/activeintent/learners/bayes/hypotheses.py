@@ -1,0 +1,271 @@
+"""The hypothesis space H: a small compositional grammar of intentions z.
+
+A hypothesis is one or two *clauses*; a clause says what a set of blocks (all blocks, the
+warm-coloured ones or the cool-coloured ones, see ``world.colors``) should do, by a
+*behaviour* (behaviours.py): a per-block target rule or a structure over the group.
+
+    H      → all: B_all | class: B_class | warm: B_pair, cool: B_pair
+    class  → warm | cool
+
+Each hypothesis is an :class:`Intention`, so it can also serve as a hidden user intention.
+Its prior is the probability of generating it from the grammar with uniform choices at every
+node: P(h) = 2^(-L(h)), L = description length in bits (docs/bayes.md). Hypotheses that
+agree on every state of a bank of feasible scenes are merged (the simplest one is kept).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from activeintent.intentions.base import Intention
+from activeintent.learners.bayes import behaviours as bh
+from activeintent.learners.bayes.facts import Facts, facts, is_cool, is_warm
+from activeintent.learners.bayes.planning import HALVES
+from activeintent.world import COLOR_NAMES, Scene, Skill, WorldState, layout, sample_scene
+from activeintent.world.skills import TABLE_POSITIONS
+
+SELECTORS = {
+    "all": lambda b: True,
+    "warm": is_warm,
+    "cool": is_cool,
+}
+SUBJECTS = {
+    "all": "the blocks",
+    "warm": "the warm-coloured blocks (red, orange, yellow, pink, brown)",
+    "cool": "the cool-coloured blocks (blue, green, purple, cyan, gray)",
+}
+REGIONS = tuple(TABLE_POSITIONS) + tuple(HALVES)
+
+
+@dataclass(frozen=True)
+class Clause:
+    selector: str  # "all" | "warm" | "cool"
+    behaviour: bh.Behaviour
+
+    def group(self, blocks: tuple[str, ...] | list[str]) -> tuple[str, ...]:
+        sel = SELECTORS[self.selector]
+        skip = self.behaviour.excluded()
+        return tuple(b for b in blocks if sel(b) and b != skip)
+
+    def group_f(self, f: Facts) -> tuple[str, ...]:
+        key = (self.selector, self.behaviour.excluded())
+        g = f.memo.get(key)
+        if g is None:
+            g = f.memo[key] = self.group(f.blocks)
+        return g
+
+
+class Hypothesis(Intention):
+    """One z: clauses, a sentence, a prior (from its description length) and a planner."""
+
+    def __init__(self, clauses: tuple[Clause, ...], bits: float, description: str | None = None):
+        self.clauses = clauses
+        self.bits = bits
+        self.name = "+".join(f"{c.selector}:{c.behaviour.key}" for c in clauses)
+        self.description = description or self._describe()
+
+    def _describe(self) -> str:
+        parts = []
+        for c in self.clauses:
+            subject = SUBJECTS[c.selector]
+            if c.behaviour.excluded():
+                subject = "the other blocks" if c.selector == "all" else f"the other {subject[4:]}"
+            parts.append(c.behaviour.phrase(subject))
+        text = " and ".join(parts)
+        if len(self.clauses) == 1 and self.clauses[0].selector != "all":
+            text += "; the other blocks may be anywhere"
+        return text[0].upper() + text[1:] + "."
+
+    # -- judging states (Facts versions are used by the learner in bulk) --
+
+    def holds_f(self, f: Facts) -> bool:
+        return all(c.behaviour.holds(f, c.group_f(f)) for c in self.clauses)
+
+    def score_f(self, f: Facts) -> float:
+        total, n = 0.0, 0
+        for c in self.clauses:
+            g = c.group_f(f)
+            total += c.behaviour.score(f, g) * len(g)
+            n += len(g)
+        return total / n if n else 1.0
+
+    def satisfied(self, state: WorldState) -> bool:
+        return self.holds_f(facts(state))
+
+    def score(self, state: WorldState) -> float:
+        return self.score_f(facts(state))
+
+    def moves_away_f(self, fb: Facts, fa: Facts, block: str) -> bool:
+        """Did moving ``block`` (facts before → after) move away from z?"""
+        if self.score_f(fa) < self.score_f(fb) - 1e-9:
+            return True
+        for c in self.clauses:
+            g = c.group_f(fa)
+            if block in g and not c.behaviour.ok(fa, g, block):
+                return True
+        return False
+
+    def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
+        if before.positions == after.positions:  # failed step: nothing moved
+            return False
+        return self.moves_away_f(facts(before), facts(after), step.block)
+
+    # -- scenes and plans --
+
+    def feasible(self, scene: Scene) -> bool:
+        objects = scene.objects
+        blocks = scene.blocks
+        for c in self.clauses:
+            g = c.group(blocks)
+            if not g or not c.behaviour.feasible(objects, g):
+                return False
+        return True
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        for _ in range(500):
+            scene = random_scene(rng)
+            if self.feasible(scene):
+                return scene
+        raise ValueError(f"no feasible scene of 3–5 objects found for {self.name!r}")
+
+    def plans(self, state: WorldState, variants: int | None = None) -> list[list[Skill]]:
+        """Distinct plans that satisfy z from ``state`` (first = the canonical one)."""
+        out: list[list[Skill]] = []
+        seen: set[str] = set()
+        n = variants or max(c.behaviour.variants for c in self.clauses)
+        for v in range(n):
+            s, steps = state, []
+            for c in self.clauses:
+                got = c.behaviour.plan(s, c.group(s.blocks), v)
+                if got is None:
+                    break
+                s, more = got
+                steps.extend(more)
+            else:
+                if self.holds_f(facts(s)):
+                    key = repr([st.model_dump() for st in steps])
+                    if key not in seen:
+                        seen.add(key)
+                        out.append(steps)
+        return out
+
+    def plan(self, state: WorldState) -> list[Skill] | None:
+        got = self.plans(state)
+        return got[0] if got else None
+
+
+def random_scene(rng: np.random.Generator) -> Scene:
+    """3–5 objects, at least two blocks and one bowl; bowls match block colours by chance."""
+    n = int(rng.integers(3, 6))
+    n_blocks = int(rng.integers(2, n))
+    matching = [True, None, False][int(rng.integers(0, 3))]
+    return sample_scene(rng, n_blocks=n_blocks, n_bowls=n - n_blocks, matching=matching)
+
+
+# ---- the grammar -------------------------------------------------------------------------
+
+ALL_FAMILIES: list[tuple[str, list[bh.Behaviour]]] = [
+    ("in-same-bowl", [bh.InSameBowl()]),
+    ("in-other-bowl", [bh.InOtherBowl()]),
+    ("in-any-bowl", [bh.InAnyBowl()]),
+    ("on-table", [bh.OnTable()]),
+    ("next-to-same-bowl", [bh.NextToSameBowl()]),
+    ("tower", [bh.Tower()]),
+    ("row", [bh.Row()]),
+    ("column", [bh.Column()]),
+    ("cluster", [bh.Cluster()]),
+    ("one-bowl", [bh.OneBowl()]),
+    ("distinct-bowls", [bh.DistinctBowls()]),
+    ("two-towers", [bh.TwoTowers()]),
+    ("in-bowl", [bh.InBowl(c) for c in COLOR_NAMES]),
+    ("next-to-bowl", [bh.NextToBowl(c) for c in COLOR_NAMES]),
+    ("next-to-block", [bh.NextToBlock(c) for c in COLOR_NAMES]),
+    ("tower-on", [bh.TowerOn(c) for c in COLOR_NAMES]),
+    ("region", [bh.InRegion(r) for r in REGIONS]),
+]
+CLASS_FAMILIES = [
+    f for f in ALL_FAMILIES
+    if f[0] in {"in-same-bowl", "in-other-bowl", "in-any-bowl", "on-table", "next-to-same-bowl",
+                "tower", "row", "column", "cluster", "one-bowl", "in-bowl", "region"}
+]
+PAIR_FAMILIES = [
+    f[1][0] for f in ALL_FAMILIES
+    if f[0] in {"in-same-bowl", "in-other-bowl", "in-any-bowl", "on-table", "next-to-same-bowl",
+                "tower", "row", "column", "cluster", "one-bowl"}
+]
+STRUCTURES = 3  # all blocks / one colour class / both colour classes
+
+
+def enumerate_hypotheses() -> list[Hypothesis]:
+    """Every hypothesis of the grammar, with its description length in bits (not deduplicated)."""
+    out: list[Hypothesis] = []
+    root = math.log2(STRUCTURES)
+    for _, members in ALL_FAMILIES:
+        for b in members:
+            bits = root + math.log2(len(ALL_FAMILIES)) + math.log2(len(members))
+            out.append(Hypothesis((Clause("all", b),), bits))
+    for cls in ("warm", "cool"):
+        for _, members in CLASS_FAMILIES:
+            for b in members:
+                bits = root + 1 + math.log2(len(CLASS_FAMILIES)) + math.log2(len(members))
+                out.append(Hypothesis((Clause(cls, b),), bits))
+    k = len(PAIR_FAMILIES)
+    for bw in PAIR_FAMILIES:
+        for bc in PAIR_FAMILIES:
+            if bw.key == bc.key:
+                continue  # the same rule for both classes is the "all" hypothesis
+            bits = root + math.log2(k) + math.log2(k - 1)
+            out.append(Hypothesis((Clause("warm", bw), Clause("cool", bc)), bits))
+    return out
+
+
+def _bank(seed: int, n_scenes: int) -> list[tuple[Scene, list[Facts]]]:
+    """Scenes with states to tell hypotheses apart: initial layouts and every hypothesis' plans."""
+    rng = np.random.default_rng(seed)
+    hyps = enumerate_hypotheses()
+    bank = []
+    for i in range(n_scenes):
+        scene = random_scene(rng)
+        state = WorldState(positions=layout(scene, seed + i))
+        states = [facts(state)]
+        for h in hyps:
+            if h.feasible(scene):
+                from activeintent.learners.bayes.planning import run
+
+                for p in h.plans(state, variants=1):
+                    end = run(state, p)
+                    if end is not None:
+                        states.append(facts(end))
+        bank.append((scene, states))
+    return bank
+
+
+@lru_cache(maxsize=4)
+def hypothesis_space(seed: int = 0, n_scenes: int = 24) -> tuple[Hypothesis, ...]:
+    """H: the grammar's hypotheses, deduplicated by behaviour on a seeded bank of scenes.
+
+    Two hypotheses are the same when they agree on feasibility and on ``satisfied`` for every
+    bank state; of each such set the one with the shortest description is kept.
+    """
+    hyps = sorted(enumerate_hypotheses(), key=lambda h: h.bits)
+    bank = _bank(seed, n_scenes)
+    kept: dict[bytes, Hypothesis] = {}
+    for h in hyps:
+        sig = []
+        for scene, states in bank:
+            feas = h.feasible(scene)
+            sig.append(feas)
+            sig.extend(h.holds_f(f) if feas else False for f in states)
+        key = np.packbits(np.array(sig, dtype=bool)).tobytes()
+        kept.setdefault(key, h)
+    return tuple(kept.values())
+
+
+def log_prior(hyps: tuple[Hypothesis, ...] | list[Hypothesis]) -> np.ndarray:
+    """log P(h) ∝ -L(h)·ln 2, normalised over ``hyps``."""
+    lp = -np.array([h.bits for h in hyps]) * math.log(2)
+    return lp - np.logaddexp.reduce(lp)

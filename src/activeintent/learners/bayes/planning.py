@@ -1,0 +1,75 @@
+"""Small planning helpers for hypothesis planners, on the symbolic world model."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from activeintent.world import BOUNDS, PutAt, Skill, SkillFailure, WorldState, apply_skill
+from activeintent.world.relations import table_position_name
+
+GRID_STEP = 0.06  # spacing of candidate free points (a block is 4 cm wide)
+
+
+def grid_points(step: float = GRID_STEP) -> list[tuple[float, float]]:
+    (x0, x1), (y0, y1) = BOUNDS
+    xs = np.arange(x0 + 0.03, x1 - 0.029, step)
+    ys = np.arange(y0 + 0.03, y1 - 0.029, step)
+    return [(round(float(x), 3), round(float(y), 3)) for y in ys for x in xs]
+
+
+GRID = grid_points()
+
+HALVES = {
+    "left half": lambda xy: xy[0] < 0.0,
+    "right half": lambda xy: xy[0] > 0.0,
+    "top half": lambda xy: xy[1] > -0.5,
+    "bottom half": lambda xy: xy[1] < -0.5,
+}
+
+
+def in_region(region: str, xy: tuple[float, float]) -> bool:
+    """``region``: a table-position name (corner, side, middle) or a half of the table."""
+    if region in HALVES:
+        return HALVES[region](xy)
+    return table_position_name(xy) == region
+
+
+def region_points(region: str) -> list[tuple[float, float]]:
+    pts = [p for p in GRID if in_region(region, p)]
+    if not pts:
+        return []
+    cx = float(np.mean([p[0] for p in pts]))
+    cy = float(np.mean([p[1] for p in pts]))
+    return sorted(pts, key=lambda p: (p[0] - cx) ** 2 + (p[1] - cy) ** 2)
+
+
+def step_ok(state: WorldState, step: Skill) -> WorldState | None:
+    """State after ``step``, or None if the step would fail."""
+    new, fail = apply_skill(state, step)
+    return None if fail is not None else new
+
+
+def put_free(
+    state: WorldState, block: str, points: list[tuple[float, float]]
+) -> tuple[WorldState, Skill] | None:
+    """Place ``block`` at the first free point of ``points`` (PutAt)."""
+    for p in points:
+        step = PutAt(block=block, position=p)
+        new, fail = apply_skill(state, step)
+        if fail is None:
+            return new, step
+    return None
+
+
+def nearest_points(state: WorldState, block: str) -> list[tuple[float, float]]:
+    here = state.pos(block)[:2]
+    return sorted(GRID, key=lambda p: (p[0] - here[0]) ** 2 + (p[1] - here[1]) ** 2)
+
+
+def run(state: WorldState, steps: list[Skill]) -> WorldState | None:
+    """Final state of ``steps``, or None if any step fails."""
+    for step in steps:
+        state, fail = apply_skill(state, step)
+        if isinstance(fail, SkillFailure):
+            return None
+    return state

@@ -1,0 +1,116 @@
+"""prompt(h) (eq. 3) and the retrievers that turn it into r (eq. 4).
+
+prompt(h) = x_n                          if h = None   (watched to the end)
+          = {I_0, x_s, I_s}              if h < ε      (stopped early)
+          = {I_0, x_b, I_b, x_s, I_s}    otherwise
+
+The ``vision`` retriever shows the images to a multimodal model p_ψ; the ``symbolic``
+retriever describes the same moments from the trajectory log (relations in I_0, I_b, I_s and
+the skill being executed at the stop), for text-only models.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+from activeintent.llm.base import ImagePart, Message, TextPart
+from activeintent.learners import prompts
+from activeintent.signals import StopFeedback
+from activeintent.sim.trajectory import Trajectory
+from activeintent.world import describe_skill, describe_state, relations
+
+RetrieverName = Literal["vision", "symbolic"]
+RETRIEVERS: tuple[str, ...] = ("vision", "symbolic")
+
+
+@dataclass
+class Moment:
+    """One of I_0, I_b, I_s: its caption x, time t and (for the vision path) the image."""
+
+    label: str
+    caption: str
+    t: float
+
+
+@dataclass
+class PromptH:
+    """prompt(h_i) of eq. 3 before rendering: the case and the moments to show."""
+
+    case: Literal["none", "early", "late"]
+    text: str  # x_n, or x_0 introducing the images
+    moments: list[Moment] = field(default_factory=list)
+
+    @property
+    def image_labels(self) -> list[str]:
+        return [m.label for m in self.moments]
+
+
+def prompt_h(traj: Trajectory, h: StopFeedback, goal: str, epsilon: float) -> PromptH:
+    """Build prompt(h) exactly as eq. 3 (ε in seconds)."""
+    x = prompts.sections("eq3_prompt_h")
+    if h.stop_time is None:
+        return PromptH("none", prompts.Template(x["x_n"]).substitute(goal=goal))
+    step = traj.step_at(h.stop_time)
+    skill = describe_skill(traj.steps[step].skill) if step is not None and traj.steps else "nothing yet"
+    x0 = prompts.Template(x["x_0"]).substitute(goal=goal)
+    xs = prompts.Template(x["x_s"]).substitute(stop_time=f"{h.stop_time:.1f}", skill=skill)
+    i0 = Moment("I_0", "", 0.0)
+    i_s = Moment("I_s", xs, h.stop_time)
+    if h.stop_time < epsilon:
+        return PromptH("early", x0, [i0, i_s])
+    xb = prompts.Template(x["x_b"]).substitute(epsilon=f"{epsilon:g}")
+    return PromptH("late", x0, [i0, Moment("I_b", xb, h.stop_time - epsilon), i_s])
+
+
+def as_images(ph: PromptH, traj: Trajectory, size: tuple[int, int] = (240, 240)) -> list[TextPart | ImagePart]:
+    """prompt(h) as message parts with rendered images I_0, I_b, I_s."""
+    parts: list[TextPart | ImagePart] = [TextPart(text=ph.text)]
+    for m in ph.moments:
+        if m.caption:
+            parts.append(TextPart(text=m.caption))
+        parts.append(ImagePart.from_array(traj.frame(m.t, size=size)))
+    return parts
+
+
+def as_text(ph: PromptH, traj: Trajectory) -> str:
+    """prompt(h) with each image replaced by a description of the scene at that moment."""
+    lines = [ph.text]
+    for m in ph.moments:
+        if m.caption:
+            lines.append(m.caption)
+        lines.append(f"[{m.label}] {describe_state(traj.state_at(m.t))}")
+    return "\n".join(lines)
+
+
+def symbolic_retrieval(ph: PromptH, traj: Trajectory, h: StopFeedback) -> str:
+    """r from the trajectory log: what changed between I_0/I_b and I_s, and the skill at the stop."""
+    if h.stop_time is None:
+        final = describe_state(traj.final_state or traj.state_at(traj.duration))
+        return f"The user accepted the whole execution. Final scene: {final}"
+    step = traj.step_at(h.stop_time)
+    doing = describe_skill(traj.steps[step].skill) if step is not None and traj.steps else "nothing"
+    first = relations(traj.state_at(ph.moments[0].t))
+    last = relations(traj.state_at(h.stop_time))
+    changes = []
+    for name, rel in (("in", "inside"), ("on", "on"), ("next to", "next_to")):
+        before = {tuple(p) for p in getattr(first, rel)}
+        after = {tuple(p) for p in getattr(last, rel)}
+        changes += [f"the {a} is now {name} the {b}" for a, b in sorted(after - before)]
+        changes += [f"the {a} is no longer {name} the {b}" for a, b in sorted(before - after)]
+    done = [describe_skill(s.skill) for s in traj.steps if s.end_tick <= traj.tick_at(h.stop_time)]
+    text = f"The user stopped the robot while it was doing: {doing}."
+    if done:
+        text += f" Already completed before the stop: {'; '.join(done)}."
+    if changes:
+        text += f" Since the start, {'; '.join(changes)}."
+    return text + f" The user objects to: {doing}."
+
+
+def vision_messages(
+    ph: PromptH, traj: Trajectory, history: str, size: tuple[int, int] = (240, 240)
+) -> list[Message]:
+    """The eq. 4 request for a multimodal model p_ψ: instructions, prompt(h) with images, earlier r."""
+    head = prompts.render("eq4_retrieve", task=prompts.render("x_task"), prompt_h="The scene images follow.",
+                          history=history or "none")
+    return [Message(role="user", content=[TextPart(text=head), *as_images(ph, traj, size)])]

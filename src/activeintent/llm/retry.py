@@ -1,0 +1,70 @@
+"""Exponential backoff with jitter for transient model failures."""
+
+from __future__ import annotations
+
+import random
+import time
+from collections.abc import Callable
+from typing import TypeVar
+
+from pydantic import BaseModel, Field
+
+R = TypeVar("R")
+
+
+class Transient(Exception):
+    """Raised by a backend attempt that may succeed when tried again."""
+
+    def __init__(self, message: str, *, unreachable: bool = False) -> None:
+        super().__init__(message)
+        self.unreachable = unreachable  # nothing answered at all (connection refused)
+
+
+class RetryPolicy(BaseModel):
+    """``max_attempts`` tries; the wait before try k+1 is
+    ``min(max_delay_s, base_delay_s * 2**k)`` scaled by a factor in [1 - jitter, 1]."""
+
+    max_attempts: int = Field(default=4, ge=1)
+    base_delay_s: float = Field(default=0.5, ge=0)
+    max_delay_s: float = Field(default=8.0, ge=0)
+    jitter: float = Field(default=0.5, ge=0, le=1)
+    seed: int = 0  # the jitter RNG's seed: runs are reproducible in their waits too
+
+    def delays(self) -> list[float]:
+        rng = random.Random(self.seed)
+        out = []
+        for k in range(self.max_attempts - 1):
+            delay = min(self.max_delay_s, self.base_delay_s * 2**k)
+            out.append(delay * (1.0 - self.jitter * rng.random()))
+        return out
+
+
+class RetryOutcome(BaseModel):
+    attempts: int
+    errors: list[str]
+    unreachable: bool
+
+
+def run_with_retry(
+    attempt: Callable[[], R],
+    policy: RetryPolicy,
+    *,
+    sleep: Callable[[float], None] = time.sleep,
+) -> tuple[R, int] | RetryOutcome:
+    """Call ``attempt`` until it returns or raises something other than :class:`Transient`.
+
+    Returns ``(result, attempts)`` or, when every attempt was transient, a :class:`RetryOutcome`
+    for the caller to turn into its typed error.
+    """
+    delays = policy.delays()
+    errors: list[str] = []
+    unreachable = True
+    for k in range(policy.max_attempts):
+        try:
+            return attempt(), k + 1
+        except Transient as exc:
+            errors.append(str(exc))
+            unreachable = unreachable and exc.unreachable
+            if k < len(delays):
+                sleep(delays[k])
+    return RetryOutcome(attempts=policy.max_attempts, errors=errors, unreachable=unreachable)

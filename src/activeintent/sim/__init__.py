@@ -1,0 +1,1 @@
+"""PyBullet tabletop: robot, assets, skills, trajectory log τ, rendering, video export."""

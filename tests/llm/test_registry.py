@@ -1,0 +1,84 @@
+"""Spec strings, shared model options, usage accounting."""
+
+from __future__ import annotations
+
+import pytest
+from fault_server import FaultServer, Ok
+from pydantic import ValidationError
+
+from activeintent.llm.accounting import CallRecord, Usage
+from activeintent.llm.base import Message
+from activeintent.llm.registry import ModelConfig, load_model, parse_spec
+
+
+@pytest.mark.parametrize(
+    ("spec", "kind", "target"),
+    [
+        ("embedded", "embedded", None),
+        ("gguf:/models/x.gguf", "gguf", "/models/x.gguf"),
+        ("openai:gpt-4o-mini", "openai", "gpt-4o-mini"),
+        ("openai:qwen2.5:7b", "openai", "qwen2.5:7b"),  # Ollama names contain colons
+    ],
+)
+def test_valid_specs(spec, kind, target):
+    parsed = parse_spec(spec)
+    assert (parsed.kind, parsed.target) == (kind, target)
+    assert str(parsed) == spec
+
+
+@pytest.mark.parametrize("spec", ["", "gpt-4", "openai:", "gguf:", "hf:gemma", "Embedded"])
+def test_bad_spec_lists_valid_forms(spec):
+    with pytest.raises(ValueError) as info:
+        parse_spec(spec)
+    message = str(info.value)
+    assert "embedded" in message and "gguf:/path/model.gguf" in message and "openai:<model-name>" in message
+
+
+def test_config_rejects_bad_options_clearly():
+    with pytest.raises(ValidationError, match="openai:<model-name>"):
+        ModelConfig(llm="gpt4")
+    with pytest.raises(ValidationError, match="record, replay, off"):
+        ModelConfig(cache_mode="replay-only")
+
+
+def test_config_builds_openai_models_sharing_cache_and_usage(tmp_path):
+    with FaultServer() as server:
+        server.default = Ok("fine")
+        config = ModelConfig(llm="openai:text-model", vlm="openai:vision-model",
+                             base_url=server.base_url, cache=tmp_path / "c.sqlite")
+        models = config.build()
+        assert models.llm is not models.vlm
+        user = [Message(role="user", content="hi")]
+        models.llm.chat(user)
+        models.vlm.chat(user)
+        models.vlm.chat(user)  # cache hit
+        assert [r["model"] for r in server.requests] == ["text-model", "vision-model"]
+        totals = models.usage.snapshot()
+        assert (totals.calls, totals.cache_hits, totals.cache_misses) == (3, 1, 2)
+        models.close()
+
+        same = ModelConfig(llm="openai:m", base_url=server.base_url, cache_mode="off").build()
+        assert same.llm is same.vlm
+
+
+def test_load_model_openai(tmp_path):
+    with FaultServer() as server:
+        server.default = Ok("pong")
+        model = load_model("openai:m", base_url=server.base_url)
+        assert model.chat([Message(role="user", content="ping")]) == "pong"
+        assert model.name == "openai:m"
+
+
+def test_usage_snapshot_diff_gives_per_episode_totals():
+    usage = Usage()
+    usage.record(CallRecord(backend="b", model="m", kind="chat", prompt_tokens=100,
+                            completion_tokens=10, latency_s=0.5))
+    start = usage.snapshot()
+    usage.record(CallRecord(backend="b", model="m", kind="structured", prompt_tokens=600,
+                            completion_tokens=60, latency_s=1.5, attempts=3))
+    usage.record(CallRecord(backend="b", model="m", kind="chat", cache_hit=True))
+    episode = usage.diff(start)
+    assert (episode.calls, episode.prompt_tokens, episode.completion_tokens) == (2, 600, 60)
+    assert (episode.cache_hits, episode.cache_misses, episode.retries) == (1, 1, 2)
+    assert episode.latency_s == pytest.approx(1.5)
+    assert usage.snapshot().calls == 3
