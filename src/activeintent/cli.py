@@ -17,8 +17,12 @@ app = typer.Typer(
 # Each module defines register(app) and adds its commands.
 _COMMAND_MODULES = (
     "activeintent.commands",
+    "activeintent.act.commands",
     "activeintent.bench.commands",
+    "activeintent.intentions.commands",
+    "activeintent.llm.commands",
     "activeintent.sim.commands",
+    "activeintent.web.commands",
 )
 
 for _module in _COMMAND_MODULES:

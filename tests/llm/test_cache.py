@@ -127,7 +127,7 @@ def _writer(path: str, worker: int, n: int) -> None:
 
 def test_several_processes_write_one_cache(tmp_path):
     path = str(tmp_path / "shared.sqlite")
-    ctx = mp.get_context("spawn")
+    ctx = mp.get_context("fork")
     workers = [ctx.Process(target=_writer, args=(path, w, 40)) for w in range(3)]
     for p in workers:
         p.start()

@@ -184,6 +184,7 @@ def test_structured_uses_json_schema_response_format(server):
 def test_server_refusing_formats_falls_back_to_json_object_then_text(server):
     server.script.extend([
         Status(400, "response_format json_schema is not supported"),
+        Status(422, "response_format.schema: extra fields not permitted"),
         Status(400, "response_format json_object is not supported"),
         Ok('Sure! ```json\n{"preference": "align", "count": 2}\n```'),
         Ok('{"preference": "align", "count": 4}'),
@@ -191,7 +192,9 @@ def test_server_refusing_formats_falls_back_to_json_object_then_text(server):
     model = make_model(server)
     assert model.structured(USER, Goal) == Goal(preference="align", count=2)
     kinds = [r.get("response_format", {}).get("type") for r in server.requests]
-    assert kinds == ["json_schema", "json_object", None]
+    assert kinds == ["json_schema", "json_object", "json_object", None]
+    assert "schema" in server.requests[1]["response_format"]
+    assert "schema" not in server.requests[2]["response_format"]
     # The fallback sticks: the next call goes straight to plain text.
     assert model.structured(USER, Goal).count == 4
     assert "response_format" not in server.requests[-1]

@@ -64,9 +64,15 @@ def test_config_builds_openai_models_sharing_cache_and_usage(tmp_path):
 def test_load_model_openai(tmp_path):
     with FaultServer() as server:
         server.default = Ok("pong")
-        model = load_model("openai:m", base_url=server.base_url)
+        model = load_model("openai:m", base_url=server.base_url, cache_path=tmp_path / "c.sqlite")
         assert model.chat([Message(role="user", content="ping")]) == "pong"
         assert model.name == "openai:m"
+        replay = load_model("openai:m", base_url=server.base_url, cache=str(tmp_path / "c.sqlite"),
+                            cache_mode="replay")
+        assert replay.chat([Message(role="user", content="ping")]) == "pong"
+        assert len(server.requests) == 1
+        with pytest.raises(ValueError, match="record, replay, off"):
+            load_model("openai:m", base_url=server.base_url, cache_mode="sometimes")
 
 
 def test_usage_snapshot_diff_gives_per_episode_totals():

@@ -221,10 +221,8 @@ class RobotAPI:
 
     def say(self, msg: Any) -> None:
         text = str(msg)
-        room = MAX_SAID_CHARS - self._said_chars
-        if room <= 0:
-            return
-        text = text[:room]
+        if self._said_chars + len(text) > MAX_SAID_CHARS:
+            raise RuntimeError(f"too much output: say() may print at most {MAX_SAID_CHARS} characters in all")
         self._said_chars += len(text)
         self.said.append(text)
 
@@ -241,6 +239,7 @@ class RobotAPI:
         )
         ns: dict[str, Any] = {n: getattr(self, n) for n in names}
         ns["np"] = SAFE_NUMPY
+        ns["objects"] = list(self.state.names)  # CaP prompts list the scene as `objects = [...]`
         return ns
 
 

@@ -25,6 +25,7 @@ import sys
 import tempfile
 import threading
 import time
+import weakref
 from pathlib import Path
 from typing import Literal
 
@@ -82,6 +83,8 @@ class Sandbox:
         self._stderr = None
         self._lock = threading.Lock()
         self.startup_s: float | None = None
+        ref = weakref.ref(self)
+        atexit.register(lambda: (sandbox := ref()) is not None and sandbox.close())  # no stray workers
 
     # ---- worker lifecycle --------------------------------------------------------------
     def start(self) -> None:
@@ -186,16 +189,26 @@ class Sandbox:
         }
         data = json.dumps(request).encode()
         with self._lock:
-            self._ensure_started()
-            assert self._proc is not None and self._proc.stdin is not None
-            try:
-                self._proc.stdin.write(struct.pack(">I", len(data)) + data)
-                self._proc.stdin.flush()
-                reply = self._read(timeout=self.limits.wall_seconds + 10.0)
-            except (BrokenPipeError, OSError, ValueError):
-                reply = None
-            if reply is None:  # the worker is stuck or dead: replace it next time
+            reply = None
+            for _attempt in range(2):  # a worker that died between programs is replaced once
+                self._ensure_started()
+                assert self._proc is not None and self._proc.stdin is not None
+                try:
+                    self._proc.stdin.write(struct.pack(">I", len(data)) + data)
+                    self._proc.stdin.flush()
+                    reply = self._read(timeout=self.limits.wall_seconds + 10.0)
+                except (OSError, ValueError):
+                    reply = None
+                if reply is not None:
+                    break
+                try:
+                    died = self._proc.wait(timeout=0.5) is not None
+                except subprocess.TimeoutExpired:
+                    died = False
                 self._stop()
+                if not died:
+                    break  # alive but stuck: do not run the program a second time
+            if reply is None:
                 return SandboxResult(
                     error="the sandbox worker stopped responding; the program was killed",
                     error_kind="sandbox", elapsed_s=time.perf_counter() - started,

@@ -96,11 +96,14 @@ class _LineIntention(Intention):
         if not on_table(rel, block):  # stacked or in a bowl: never part of the line
             return True
         across = after.pos(block)[1 - self.axis]
-        # Next to a block but off its line (e.g. in front of it when a row is wanted).
-        return any(
-            rel.is_next_to(block, other) and abs(after.pos(other)[1 - self.axis] - across) > LINE_TOL
-            for other in after.blocks
-            if other != block and on_table(rel, other)
+        # Set beside blocks but in line with none of them (e.g. in front of a block when a
+        # row is wanted). Touching a not-yet-moved block crosswise while joining the row is fine.
+        neighbours = [
+            other for other in after.blocks
+            if other != block and on_table(rel, other) and rel.is_next_to(block, other)
+        ]
+        return bool(neighbours) and all(
+            abs(after.pos(other)[1 - self.axis] - across) > LINE_TOL for other in neighbours
         )
 
     def feasible(self, scene: Scene) -> bool:

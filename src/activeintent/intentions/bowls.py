@@ -7,7 +7,16 @@ import numpy as np
 
 from activeintent.intentions.blockwise import BlockwiseIntention
 from activeintent.intentions.placement import free_spot, on_table
-from activeintent.world import COLOR_NAMES, PutIn, PutNextTo, Relations, Scene, Skill, WorldState, relations
+from activeintent.world import (
+    COLOR_NAMES,
+    PutIn,
+    PutNextTo,
+    Relations,
+    Scene,
+    Skill,
+    WorldState,
+    relations,
+)
 from activeintent.world.predict import apply_skill
 from activeintent.world.scene import color_of
 

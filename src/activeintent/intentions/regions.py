@@ -9,8 +9,23 @@ from __future__ import annotations
 import numpy as np
 
 from activeintent.intentions.blockwise import BlockwiseIntention
-from activeintent.intentions.placement import TABLE_INNER, free_spot, grid, is_warm, nearest_first, on_table
-from activeintent.world import COOL_COLORS, WARM_COLORS, Relations, Scene, Skill, WorldState, relations
+from activeintent.intentions.placement import (
+    TABLE_INNER,
+    free_spot,
+    grid,
+    is_warm,
+    nearest_first,
+    on_table,
+)
+from activeintent.world import (
+    COOL_COLORS,
+    WARM_COLORS,
+    Relations,
+    Scene,
+    Skill,
+    WorldState,
+    relations,
+)
 from activeintent.world.skills import TABLE_POSITIONS
 
 CORNERS = ("top left corner", "top right corner", "bottom left corner", "bottom right corner")

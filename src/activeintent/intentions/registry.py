@@ -13,9 +13,21 @@ import inspect
 import sys
 from pathlib import Path
 
-from activeintent.intentions.arrangements import Align, AlignVertical, Stack, TwoTowers, WarmInBowlsCoolStacked
+from activeintent.intentions.arrangements import (
+    Align,
+    AlignVertical,
+    Stack,
+    TwoTowers,
+    WarmInBowlsCoolStacked,
+)
 from activeintent.intentions.base import Intention
-from activeintent.intentions.bowls import ColorMatch, ColorMismatch, NextToSameColorBowl, OneBlockPerBowl, OneBowl
+from activeintent.intentions.bowls import (
+    ColorMatch,
+    ColorMismatch,
+    NextToSameColorBowl,
+    OneBlockPerBowl,
+    OneBowl,
+)
 from activeintent.intentions.regions import BlocksInCorners, BlocksLeftHalf, WarmLeftCoolRight
 
 PAPER_INTENTIONS: tuple[str, ...] = ("align", "stack", "color-match", "color-mismatch")

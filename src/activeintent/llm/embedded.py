@@ -20,6 +20,11 @@ from pydantic import BaseModel, Field
 from activeintent.llm.backend import Backend, ChatRequest, Completion
 from activeintent.llm.base import Message, ModelError, ModelUnavailableError
 
+# llama.cpp's OpenMP workers spin while waiting by default; on a busy 2-core machine (physics,
+# other processes) that makes generation several times slower. Must be set before the library
+# loads; a value the user set wins.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 
 def default_model_dir() -> Path:
     return Path.home() / ".cache" / "activeintent" / "models"
@@ -93,9 +98,28 @@ def _grammar_text(schema_json: str) -> str:
 
 
 def plain_prompt(messages: list[Message]) -> str:
-    """A transcript prompt for a GGUF without a chat template (base models)."""
+    """A transcript prompt for a GGUF with neither a chat template nor turn markers."""
     lines = [f"{m.role.capitalize()}: {m.text}" for m in messages]
     return "\n\n".join(lines) + "\n\nAssistant:"
+
+
+def turn_prompt(messages: list[Message]) -> str:
+    """Gemma's turn markers (in the vocabulary even of the base model, whose GGUF carries no
+    chat template); a system message joins the first user turn as Gemma's own template does."""
+    turns: list[tuple[str, str]] = []
+    pending_system = ""
+    for m in messages:
+        if m.role == "system":
+            pending_system += m.text + "\n\n"
+            continue
+        role = "model" if m.role == "assistant" else "user"
+        text = pending_system + m.text if role == "user" else m.text
+        pending_system = "" if role == "user" else pending_system
+        turns.append((role, text))
+    if pending_system:
+        turns.append(("user", pending_system.strip()))
+    body = "".join(f"<start_of_turn>{r}\n{t}<end_of_turn>\n" for r, t in turns)
+    return body + "<start_of_turn>model\n"
 
 
 class EmbeddedBackend(Backend):
@@ -121,7 +145,16 @@ class EmbeddedBackend(Backend):
             self.model_name = f"{self.path.name}@{self.path.stat().st_size}"
         self.llama = load_llama(self.path, self.config)
         self.has_chat_template = bool(self.llama.metadata.get("tokenizer.chat_template"))
+        self.prompt_format = "chat_template" if self.has_chat_template else (
+            "turns" if self._has_turn_markers() else "plain"
+        )
         self._lock = threading.Lock()  # a Llama holds one KV cache: one call at a time
+
+    def _has_turn_markers(self) -> bool:
+        return all(
+            len(self.llama.tokenize(marker, add_bos=False, special=True)) == 1
+            for marker in (b"<start_of_turn>", b"<end_of_turn>")
+        )
 
     def complete(self, request: ChatRequest) -> Completion:
         from llama_cpp import LlamaGrammar
@@ -144,13 +177,14 @@ class EmbeddedBackend(Backend):
                     )
                     text = out["choices"][0]["message"]["content"] or ""
                 else:
+                    turns = self.prompt_format == "turns"
                     out = self.llama.create_completion(
-                        prompt=plain_prompt(request.messages),
+                        prompt=(turn_prompt if turns else plain_prompt)(request.messages),
                         temperature=request.temperature,
                         max_tokens=request.max_tokens,
                         seed=request.seed,
                         grammar=grammar,
-                        stop=["\n\nUser:", "\n\nSystem:"],
+                        stop=["<end_of_turn>"] if turns else ["\n\nUser:", "\n\nSystem:"],
                     )
                     text = out["choices"][0]["text"]
             except ValueError as exc:  # e.g. the prompt exceeds n_ctx

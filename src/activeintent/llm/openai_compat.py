@@ -18,7 +18,13 @@ from typing import Any
 
 import openai
 
-from activeintent.llm.backend import Backend, ChatRequest, Completion, schema_instruction, with_instruction
+from activeintent.llm.backend import (
+    Backend,
+    ChatRequest,
+    Completion,
+    schema_instruction,
+    with_instruction,
+)
 from activeintent.llm.base import (
     ImagePart,
     Message,
@@ -28,8 +34,11 @@ from activeintent.llm.base import (
 )
 from activeintent.llm.retry import RetryOutcome, RetryPolicy, Transient, run_with_retry
 
-# Tried in this order; a server that rejects one (HTTP 400) is asked with the next.
-FORMAT_MODES = ("json_schema", "json_object", "text")
+# Tried in this order; a server that rejects one (HTTP 400/422) is asked with the next.
+# "json_object_schema" is json_object plus a "schema" key, the form llama-cpp-python's server
+# takes (it turns the schema into a grammar).
+FORMAT_MODES = ("json_schema", "json_object_schema", "json_object", "text")
+_REFUSED = (openai.BadRequestError, openai.UnprocessableEntityError)
 DUMMY_API_KEY = "sk-no-key-needed"
 
 
@@ -61,6 +70,8 @@ def response_format(mode: str, request: ChatRequest) -> dict[str, Any] | None:
                 "strict": False,  # pydantic schemas with defaults are not "strict"-compatible
             },
         }
+    if mode == "json_object_schema":
+        return {"type": "json_object", "schema": request.json_schema}
     if mode == "json_object":
         return {"type": "json_object"}
     return None
@@ -121,7 +132,7 @@ class OpenAIBackend(Backend):
                 messages = with_instruction(messages, schema_instruction(request.json_schema or {}))
             try:
                 return self._complete_with_retry(request, encode_messages(messages), mode)
-            except openai.BadRequestError as exc:
+            except _REFUSED as exc:
                 detail = _error_detail(exc)
                 if "max_completion_tokens" in detail and self._max_tokens_field == "max_tokens":
                     self._max_tokens_field = "max_completion_tokens"
@@ -164,8 +175,8 @@ class OpenAIBackend(Backend):
                         f"openai:{self.model_name} at {self.where}: HTTP {exc.status_code} "
                         f"{_error_detail(exc)}"
                     ) from exc
-                if exc.status_code == 400:
-                    raise
+                if exc.status_code in (400, 422):
+                    raise  # a refused request: complete() may try another format
                 raise ModelError(
                     f"openai:{self.model_name} at {self.where}: HTTP {exc.status_code} "
                     f"{_error_detail(exc)}"

@@ -48,7 +48,9 @@ def load_model(
     spec: str,
     *,
     base_url: str | None = None,
-    cache: ResponseCache | None = None,
+    cache: ResponseCache | str | Path | None = None,
+    cache_path: str | Path | None = None,
+    cache_mode: str = "record",
     usage: Usage | None = None,
     embedded: EmbeddedConfig | None = None,
     retry: RetryPolicy | None = None,
@@ -56,8 +58,17 @@ def load_model(
     max_repairs: int = 2,
     seed: int = 0,
 ) -> ChatModel:
-    """Build the model named by ``spec``; ``cache=None`` means no response cache."""
+    """Build the model named by ``spec``.
+
+    ``cache`` is a :class:`ResponseCache`, or the cache file (also accepted as ``cache_path``;
+    default ~/.cache/activeintent/responses.sqlite) opened in ``cache_mode``
+    (record | replay | off).
+    """
     parsed = parse_spec(spec)
+    check_mode(cache_mode)
+    if not isinstance(cache, ResponseCache):
+        path = cache if cache is not None else cache_path
+        cache = ResponseCache(path, cache_mode) if cache_mode != "off" else None
     if parsed.kind == "openai":
         from activeintent.llm.openai_compat import OpenAIBackend
 
@@ -122,7 +133,7 @@ class ModelConfig(BaseModel):
 
     def build(self, usage: Usage | None = None) -> Models:
         usage = usage if usage is not None else Usage()
-        cache = ResponseCache(self.cache, self.cache_mode) if self.cache_mode != "off" else None
+        cache = ResponseCache(self.cache, self.cache_mode)
         embedded = self.embedded.model_copy(update={"seed": self.seed})
 
         def make(spec: str) -> ChatModel:
@@ -130,6 +141,7 @@ class ModelConfig(BaseModel):
                 spec,
                 base_url=self.base_url,
                 cache=cache,
+                cache_mode=self.cache_mode,
                 usage=usage,
                 embedded=embedded,
                 retry=self.retry.model_copy(update={"seed": self.seed}),

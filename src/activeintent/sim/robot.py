@@ -67,8 +67,9 @@ class Panda:
         return np.array([s[0] for s in states])
 
     def set_joints(self, q: np.ndarray | list[float]) -> None:
-        for j, v in zip(self.movable, q, strict=True):
-            p.resetJointState(self.body, j, float(v), physicsClientId=self.client)
+        p.resetJointStatesMultiDof(
+            self.body, self.movable, [[float(v)] for v in q], physicsClientId=self.client
+        )
 
     def ee_pose(self) -> tuple[np.ndarray, np.ndarray]:
         ls = p.getLinkState(self.body, EE_LINK, computeForwardKinematics=True, physicsClientId=self.client)
@@ -87,21 +88,36 @@ class Panda:
         ``seeds``; the joint state is left unchanged."""
         target = np.asarray(target, dtype=float)
         saved = self.joints()
+        # Fast path while tracking a path: one damped-least-squares solve from the current
+        # joints is exact when the target is close to where the hand already is.
+        q = np.array(p.calculateInverseKinematics(
+            self.body, EE_LINK, target, DOWN, maxNumIterations=50, residualThreshold=1e-6,
+            physicsClientId=self.client,
+        ))
+        q[-2:] = fingers
+        if np.all(q >= self.lower) and np.all(q <= self.upper):
+            err = self._fk_error(q, target)
+            if err < 5e-4:
+                self.set_joints(saved)
+                return q, err
         starts = [saved] + [np.array([*s, fingers, fingers]) for s in (seeds or [])]
         best, best_err = saved, np.inf
         for start in starts:
             q = np.array(start, dtype=float)
             # One pass pulled towards the start (keeps the arm's configuration), then plain
             # damped least squares to remove the residual that the null-space pull leaves.
+            # (IK starts from the body's joint state: passing currentPositions ignores the
+            # base pose in PyBullet 3.2, so the joints are set instead.)
+            self.set_joints(q)
             q = np.array(p.calculateInverseKinematics(
                 self.body, EE_LINK, target, DOWN, self.lower, self.upper, self.ranges, list(q),
-                currentPositions=list(q), maxNumIterations=50, residualThreshold=1e-5,
-                physicsClientId=self.client,
+                maxNumIterations=50, residualThreshold=1e-5, physicsClientId=self.client,
             ))
             for _ in range(2):
+                self.set_joints(q)
                 q = np.array(p.calculateInverseKinematics(
-                    self.body, EE_LINK, target, DOWN, currentPositions=list(q),
-                    maxNumIterations=50, residualThreshold=1e-6, physicsClientId=self.client,
+                    self.body, EE_LINK, target, DOWN, maxNumIterations=50,
+                    residualThreshold=1e-6, physicsClientId=self.client,
                 ))
             q = np.clip(q, self.lower, self.upper)
             q[-2:] = fingers

@@ -78,8 +78,8 @@ def stop_feedback(traj: Trajectory, t: float, fps: int) -> StopFeedback:
         raise AnswerRejected(
             f"stop time {t!r} s is outside the video (valid: 0 to {length:.3f} s)", status=422
         )
-    frame = min(int(math.floor(t * fps + 1e-9)), video_frames(traj.duration, fps) - 1)
     stop_time = min(float(t), traj.duration)
+    frame = int(math.floor(stop_time * fps + 1e-9))
     return StopFeedback(
         stop_time=stop_time,
         tick=traj.tick_at(stop_time),

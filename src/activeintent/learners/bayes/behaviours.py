@@ -9,6 +9,7 @@ be shown (``feasible``), and plan it on the symbolic world model (``plan``).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import combinations
 
 from activeintent.learners.bayes.facts import ALIGN_TOL, Facts, facts
 from activeintent.learners.bayes.planning import (
@@ -22,6 +23,8 @@ from activeintent.world import PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState
 from activeintent.world.scene import color_of
 
 Group = tuple[str, ...]
+ROW_PITCH = 0.052  # centre spacing of blocks set next to each other (world.predict)
+MIN_SPACING = 0.03
 PlanResult = tuple[WorldState, list[Skill]] | None
 
 
@@ -48,6 +51,10 @@ class Behaviour:
 
     def holds(self, f: Facts, group: Group) -> bool:
         return all(self.ok(f, group, b) for b in group)
+
+    def moved_ok(self, fb: Facts, fa: Facts, group: Group, b: str) -> bool:
+        """After ``b`` was moved (facts before → after), is its new place consistent with z?"""
+        return self.ok(fa, group, b)
 
     def score(self, f: Facts, group: Group) -> float:
         return sum(self.ok(f, group, b) for b in group) / len(group) if group else 1.0
@@ -243,30 +250,52 @@ class InRegion(Behaviour):
         return f"{s} go to the {where} of the table (not in bowls)"
 
     def ok(self, f, group, b):
-        if f.bowl_of[b] is not None:
+        if b not in f.on_table or f.below[b] is not None:
             return False
         return in_region(self.param, f.xy[b]) if self.param in HALVES else f.cell[b] == self.param
 
     def target(self, state, group, b, variant):
         got = put_free(state, b, region_points(self.param))
-        if got:
-            return got[1]
+        return got[1] if got else None
+
+
+class DistinctCorners(Behaviour):
+    family = "distinct-corners"
+    corners = ("top left corner", "top right corner", "bottom left corner", "bottom right corner")
+
+    def phrase(self, s: str) -> str:
+        return f"{s} go on the table, each in a different corner of the table"
+
+    def _corner(self, f: Facts, b: str) -> str | None:
+        ok = b in f.on_table and f.below[b] is None and f.cell[b] in self.corners
+        return f.cell[b] if ok else None
+
+    def ok(self, f, group, b):
+        mine = self._corner(f, b)
+        return mine is not None and all(self._corner(f, o) != mine for o in group if o != b)
+
+    def feasible(self, objects, group):
+        return len(group) <= 4
+
+    def target(self, state, group, b, variant):
         f = facts(state)
-        for other in group:  # no free spot left: stack on a block already there
-            if other != b and self.ok(f, group, other) and f.clear(other):
-                return PutOn(block=b, target=other)
+        taken = {self._corner(f, o) for o in group if o != b}
+        for corner in self.corners:
+            if corner not in taken and (got := put_free(state, b, region_points(corner))):
+                return got[1]
         return None
 
 
 # ---- structures over the group ---------------------------------------------------------
 
 
-def _towers(f: Facts, group: Group) -> list[list[str]]:
-    """Towers on the table built from group blocks only (single blocks count as height 1)."""
+def _towers(f: Facts, group: Group, table_only: bool = False) -> list[list[str]]:
+    """Towers built from group blocks only (single blocks count as height 1); with
+    ``table_only`` only those standing on the table (not in a bowl)."""
     gs = set(group)
     out = []
     for b in group:
-        if f.below[b] is None and b in f.on_table:
+        if f.below[b] is None and (not table_only or b in f.on_table):
             chain = f.tower(b)
             if all(c in gs for c in chain):
                 out.append(chain)
@@ -277,8 +306,15 @@ class Tower(Behaviour):
     family = "tower"
     variants = 3
 
+    def __init__(self, table_only: bool = False):
+        self.table_only = table_only
+
     def phrase(self, s: str) -> str:
-        return f"{s} are stacked into one tower on the table"
+        return f"{s} are stacked into one tower" + (" standing on the table" if self.table_only else "")
+
+    def moved_ok(self, fb: Facts, fa: Facts, group: Group, b: str) -> bool:
+        # Building a tower only ever puts blocks on blocks.
+        return fa.below[b] is not None or (len(group) == 1 and self.ok(fa, group, b))
 
     def base_ok(self, base: str) -> bool:
         return True
@@ -286,25 +322,25 @@ class Tower(Behaviour):
     def holds(self, f, group):
         if not group:
             return True
-        towers = [t for t in _towers(f, group) if len(t) == len(group)]
+        towers = [t for t in _towers(f, group, self.table_only) if len(t) == len(group)]
         return bool(towers) and self.base_ok(towers[0][0])
 
     def ok(self, f, group, b):
         if len(group) == 1:
             return f.flat(b)
-        towers = [t for t in _towers(f, group) if self.base_ok(t[0]) or len(t) == 1]
+        towers = [t for t in _towers(f, group, self.table_only) if self.base_ok(t[0]) or len(t) == 1]
         best = max((len(t) for t in towers), default=0)
         return best >= 2 and any(b in t and len(t) == best for t in towers)
 
     def score(self, f, group):
         if not group:
             return 1.0
-        towers = [t for t in _towers(f, group) if self.base_ok(t[0]) or len(t) == 1]
+        towers = [t for t in _towers(f, group, self.table_only) if self.base_ok(t[0]) or len(t) == 1]
         return max((len(t) for t in towers), default=0) / len(group)
 
     def bases(self, state: WorldState, group: Group) -> list[str]:
         f = facts(state)
-        towers = sorted(_towers(f, group), key=len, reverse=True)
+        towers = sorted(_towers(f, group, self.table_only), key=len, reverse=True)
         return [t[0] for t in towers if self.base_ok(t[0])]
 
     def plan(self, state, group, variant=0):
@@ -331,11 +367,13 @@ class Tower(Behaviour):
         return state, steps
 
 
-@dataclass
 class TowerOn(Tower):
-    param: str = "red"
     family = "tower-on"
     variants = 2
+
+    def __init__(self, param: str = "red"):
+        super().__init__(False)
+        self.param = param
 
     def phrase(self, s: str) -> str:
         return f"{s} are stacked into one tower on the {self.param} block"
@@ -355,7 +393,7 @@ class TwoTowers(Behaviour):
         return f"{s} are stacked into two towers on the table"
 
     def holds(self, f, group):
-        towers = [t for t in _towers(f, group)]
+        towers = _towers(f, group)
         return len(towers) == 2 and all(len(t) >= 2 for t in towers) and sum(map(len, towers)) == len(group)
 
     def ok(self, f, group, b):
@@ -380,34 +418,48 @@ class TwoTowers(Behaviour):
 
 
 class Line(Behaviour):
-    """Row (left-right, same y) or column (front-back, same x) of flat blocks."""
+    """Row (left-right, same y) or column (front-back, same x) of flat blocks, each next to
+    its neighbour along the line."""
 
     axis = 1  # coordinate that must agree: 1 = y (a row)
     sides = ("right", "left")
 
-    def _spread_ok(self, f, blocks) -> bool:
-        vals = [f.xy[b][self.axis] for b in blocks]
-        return max(vals) - min(vals) <= 1.5 * ALIGN_TOL
+    def _line(self, f: Facts, blocks) -> bool:
+        if not blocks:
+            return True
+        if not all(f.flat(b) for b in blocks):
+            return False
+        across = [f.xy[b][self.axis] for b in blocks]
+        if max(across) - min(across) > ALIGN_TOL:
+            return False
+        along = sorted(blocks, key=lambda b: f.xy[b][1 - self.axis])
+        return all(
+            f.xy[b][1 - self.axis] - f.xy[a][1 - self.axis] >= MIN_SPACING and f.next_to(a, b)
+            for a, b in zip(along, along[1:])
+        )
 
     def holds(self, f, group):
-        return all(f.flat(b) for b in group) and (len(group) < 2 or self._spread_ok(f, group))
+        return self._line(f, group)
 
     def ok(self, f, group, b):
-        if not f.flat(b):
+        return f.flat(b) and (len(group) == 1 or any(self._line(f, (b, o)) for o in group if o != b))
+
+    def moved_ok(self, fb, fa, group, b):
+        # Set beside blocks but in line with none of them moves away; alone on the table is fine.
+        if not fa.flat(b):
             return False
-        if len(group) == 1:
-            return True
-        v = f.xy[b][self.axis]
-        return any(o != b and f.flat(o) and abs(f.xy[o][self.axis] - v) <= 1.5 * ALIGN_TOL for o in group)
+        v = fa.xy[b][self.axis]
+        near = [o for o in fa.blocks if o != b and fa.flat(o) and fa.next_to(b, o)]
+        return not near or any(abs(fa.xy[o][self.axis] - v) <= ALIGN_TOL for o in near)
 
     def score(self, f, group):
-        flat = sorted(f.xy[b][self.axis] for b in group if f.flat(b))
-        best, j = 0, 0
-        for i, v in enumerate(flat):
-            while v - flat[j] > 1.5 * ALIGN_TOL:
-                j += 1
-            best = max(best, i - j + 1)
-        return best / len(group) if group else 1.0
+        if not group:
+            return 1.0
+        flat = [b for b in group if f.flat(b)]
+        for size in range(len(flat), 1, -1):
+            if any(self._line(f, c) for c in combinations(flat, size)):
+                return size / len(group)
+        return min(1, len(flat)) / len(group)
 
     def plan(self, state, group, variant=0):
         if len(group) < 2:
@@ -418,7 +470,7 @@ class Line(Behaviour):
         k = variant % len(tries)
         for anchor, side in tries[k:] + tries[:k]:
             s, steps, prev = state, [], anchor
-            for b in [g for g in group if g != anchor]:
+            for b in sorted((g for g in group if g != anchor), key=lambda g: -state.pos(g)[2]):
                 step = PutNextTo(block=b, target=prev, side=side)
                 s, fail = apply_skill(s, step)
                 if fail is not None:
@@ -431,12 +483,12 @@ class Line(Behaviour):
         return self._plan_points(state, group)
 
     def _plan_points(self, state, group):
-        # Fallback: lay the blocks out on a free line of points.
-        for c in (-0.02, 0.0, 0.06, -0.09, 0.1) if self.axis == 0 else (-0.5, -0.4, -0.6, -0.3, -0.7):
+        # Fallback: lay the blocks out at ROW_PITCH on a free line of points.
+        for c in (-0.5, -0.4, -0.6, -0.3, -0.7) if self.axis == 1 else (0.0, -0.1, 0.1, -0.2, 0.2):
             for start in (-0.2, -0.1, 0.0) if self.axis == 1 else (-0.7, -0.6, -0.5):
                 s, steps = state, []
                 for i, b in enumerate(group):
-                    p = (start + 0.06 * i, c) if self.axis == 1 else (c, start + 0.06 * i)
+                    p = (start + ROW_PITCH * i, c) if self.axis == 1 else (c, start + ROW_PITCH * i)
                     step = PutAt(block=b, position=p)
                     s, fail = apply_skill(s, step)
                     if fail is not None:

@@ -15,16 +15,20 @@ agree on every state of a bank of feasible scenes are merged (the simplest one i
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
+import os
 from dataclasses import dataclass
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
 from activeintent.intentions.base import Intention
 from activeintent.learners.bayes import behaviours as bh
 from activeintent.learners.bayes.facts import Facts, facts, is_cool, is_warm
-from activeintent.learners.bayes.planning import HALVES
+from activeintent.learners.bayes.planning import HALVES, run
 from activeintent.world import COLOR_NAMES, Scene, Skill, WorldState, layout, sample_scene
 from activeintent.world.skills import TABLE_POSITIONS
 
@@ -93,6 +97,9 @@ class Hypothesis(Intention):
             n += len(g)
         return total / n if n else 1.0
 
+    def prefetch(self, states: list[Facts]) -> None:
+        """Judge many states at once (hypotheses that run code in a sandbox batch them)."""
+
     def satisfied(self, state: WorldState) -> bool:
         return self.holds_f(facts(state))
 
@@ -101,11 +108,13 @@ class Hypothesis(Intention):
 
     def moves_away_f(self, fb: Facts, fa: Facts, block: str) -> bool:
         """Did moving ``block`` (facts before → after) move away from z?"""
-        if self.score_f(fa) < self.score_f(fb) - 1e-9:
-            return True
+        return self.score_f(fa) < self.score_f(fb) - 1e-9 or self.moved_off(fb, fa, block)
+
+    def moved_off(self, fb: Facts, fa: Facts, block: str) -> bool:
+        """Is the moved block's new place inconsistent with z (the score aside)?"""
         for c in self.clauses:
             g = c.group_f(fa)
-            if block in g and not c.behaviour.ok(fa, g, block):
+            if block in g and not c.behaviour.moved_ok(fb, fa, g, block):
                 return True
         return False
 
@@ -175,6 +184,7 @@ ALL_FAMILIES: list[tuple[str, list[bh.Behaviour]]] = [
     ("on-table", [bh.OnTable()]),
     ("next-to-same-bowl", [bh.NextToSameBowl()]),
     ("tower", [bh.Tower()]),
+    ("distinct-corners", [bh.DistinctCorners()]),
     ("row", [bh.Row()]),
     ("column", [bh.Column()]),
     ("cluster", [bh.Cluster()]),
@@ -188,15 +198,16 @@ ALL_FAMILIES: list[tuple[str, list[bh.Behaviour]]] = [
     ("region", [bh.InRegion(r) for r in REGIONS]),
 ]
 CLASS_FAMILIES = [
-    f for f in ALL_FAMILIES
-    if f[0] in {"in-same-bowl", "in-other-bowl", "in-any-bowl", "on-table", "next-to-same-bowl",
+    (name, [bh.Tower(table_only=True)]) if name == "tower" else (name, members)
+    for name, members in ALL_FAMILIES
+    if name in {"in-same-bowl", "in-other-bowl", "in-any-bowl", "on-table", "next-to-same-bowl",
                 "tower", "row", "column", "cluster", "one-bowl", "in-bowl", "region"}
 ]
 PAIR_FAMILIES = [
-    f[1][0] for f in ALL_FAMILIES
+    f[1][0] for f in CLASS_FAMILIES
     if f[0] in {"in-same-bowl", "in-other-bowl", "in-any-bowl", "on-table", "next-to-same-bowl",
                 "tower", "row", "column", "cluster", "one-bowl"}
-]
+] + [bh.InRegion("left half"), bh.InRegion("right half")]
 STRUCTURES = 3  # all blocks / one colour class / both colour classes
 
 
@@ -223,46 +234,75 @@ def enumerate_hypotheses() -> list[Hypothesis]:
     return out
 
 
-def _bank(seed: int, n_scenes: int) -> list[tuple[Scene, list[Facts]]]:
-    """Scenes with states to tell hypotheses apart: initial layouts and every hypothesis' plans."""
+def _bank(seed: int, others: int) -> list[tuple[Scene, list[Facts]]]:
+    """Scenes with states that tell hypotheses apart.
+
+    For every hypothesis: a scene it is feasible in (seeded), its initial layout, the final
+    states of its alternative plans and of the plans of a few other feasible hypotheses.
+    """
     rng = np.random.default_rng(seed)
     hyps = enumerate_hypotheses()
     bank = []
-    for i in range(n_scenes):
-        scene = random_scene(rng)
+    for i, h in enumerate(hyps):
+        scene = h.sample_scene(rng)
         state = WorldState(positions=layout(scene, seed + i))
         states = [facts(state)]
-        for h in hyps:
-            if h.feasible(scene):
-                from activeintent.learners.bayes.planning import run
-
-                for p in h.plans(state, variants=1):
-                    end = run(state, p)
-                    if end is not None:
-                        states.append(facts(end))
+        feasible = [g for g in hyps if g is not h and g.feasible(scene)]
+        picked = [feasible[j] for j in rng.choice(len(feasible), size=min(others, len(feasible)), replace=False)]
+        plans = h.plans(state) + [p for g in picked for p in g.plans(state, variants=1)]
+        for p in plans:
+            end = run(state, p)
+            if end is not None:
+                states.append(facts(end))
         bank.append((scene, states))
     return bank
 
 
-@lru_cache(maxsize=4)
-def hypothesis_space(seed: int = 0, n_scenes: int = 24) -> tuple[Hypothesis, ...]:
-    """H: the grammar's hypotheses, deduplicated by behaviour on a seeded bank of scenes.
+def _cache_file(seed: int, others: int) -> Path:
+    src = Path(__file__).parent
+    digest = hashlib.sha256()
+    for name in ("hypotheses.py", "behaviours.py", "facts.py", "planning.py"):
+        digest.update((src / name).read_bytes())
+    for mod in ("predict.py", "relations.py", "scene.py", "skills.py", "colors.py"):
+        digest.update((Path(layout.__code__.co_filename).parent / mod).read_bytes())
+    root = Path(os.environ.get("ACTIVEINTENT_CACHE", Path.home() / ".cache" / "activeintent"))
+    return root / f"bayes-hypotheses-{digest.hexdigest()[:16]}-{seed}-{others}.json"
+
+
+def distinct_names(seed: int = 0, others: int = 6) -> list[str]:
+    """Names of the hypotheses kept after merging those that behave the same on the bank.
 
     Two hypotheses are the same when they agree on feasibility and on ``satisfied`` for every
-    bank state; of each such set the one with the shortest description is kept.
+    bank state; of each such set the one with the shortest description is kept. The result is
+    cached on disk (keyed by the source of the grammar and the world model): it takes seconds.
     """
+    path = _cache_file(seed, others)
+    if path.exists():
+        return json.loads(path.read_text())
     hyps = sorted(enumerate_hypotheses(), key=lambda h: h.bits)
-    bank = _bank(seed, n_scenes)
-    kept: dict[bytes, Hypothesis] = {}
+    bank = _bank(seed, others)
+    kept: dict[bytes, str] = {}
     for h in hyps:
         sig = []
         for scene, states in bank:
             feas = h.feasible(scene)
             sig.append(feas)
             sig.extend(h.holds_f(f) if feas else False for f in states)
-        key = np.packbits(np.array(sig, dtype=bool)).tobytes()
-        kept.setdefault(key, h)
-    return tuple(kept.values())
+        kept.setdefault(np.packbits(np.array(sig, dtype=bool)).tobytes(), h.name)
+    names = list(kept.values())
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(names))
+    except OSError:
+        pass  # a read-only home only costs the recomputation
+    return names
+
+
+@lru_cache(maxsize=4)
+def hypothesis_space(seed: int = 0, others: int = 6) -> tuple[Hypothesis, ...]:
+    """H: the grammar's hypotheses, deduplicated by behaviour (simplest first)."""
+    keep = set(distinct_names(seed, others))
+    return tuple(h for h in sorted(enumerate_hypotheses(), key=lambda h: h.bits) if h.name in keep)
 
 
 def log_prior(hyps: tuple[Hypothesis, ...] | list[Hypothesis]) -> np.ndarray:

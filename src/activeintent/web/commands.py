@@ -1,0 +1,71 @@
+"""`activeintent serve`: the human-in-the-loop web app."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from activeintent import options as opt
+
+
+def register(app: typer.Typer) -> None:
+    app.command(name="serve")(serve)
+
+
+def serve(
+    host: Annotated[str, typer.Option("--host", help="Address to bind (loopback unless told otherwise)")] = "127.0.0.1",
+    port: Annotated[int, typer.Option("--port", min=0, max=65535, help="TCP port")] = 8000,
+    method: Annotated[str, typer.Option("--method", help="preference | mllm | mllm-llm | bayes-preference | bayes-stop")] = "bayes-preference",
+    rounds: opt.Rounds = 5,
+    intention: opt.Intention = None,
+    intention_file: opt.IntentionFile = None,
+    seed: Annotated[int, typer.Option("--seed", help="Session n runs with seed + n")] = 0,
+    out: Annotated[Path, typer.Option("--out", help="Sessions are saved in OUT/<session-id>/")] = Path("runs/web"),
+    show_estimate: Annotated[bool, typer.Option("--show-estimate/--hide-estimate", help="Show the learner's current estimate z to the participant")] = True,
+    llm: opt.Llm = "embedded",
+    vlm: opt.Vlm = None,
+    base_url: opt.BaseUrl = None,
+    cache: opt.Cache = None,
+    executor: opt.Executor = "plan",
+    retriever: opt.Retriever = "symbolic",
+    answer_timeout: Annotated[float, typer.Option("--answer-timeout", min=1.0, help="Seconds to wait for one answer before a session is abandoned")] = 1800.0,
+    max_sessions: Annotated[int, typer.Option("--max-sessions", min=1, help="Sessions in progress at once")] = 4,
+) -> None:
+    """Serve the study: participants give the preference or stop signal in the browser.
+
+    Every session is saved like a simulated run (summary.json, rounds.jsonl, videos) in
+    OUT/<session-id>/, plus events.jsonl with every UI event. The JSON API is described at
+    /openapi.json.
+    """
+    import uvicorn
+    from rich.console import Console
+
+    from activeintent.intentions.registry import IntentionError, resolve_intention
+    from activeintent.learners.registry import SIGNAL, check_method
+    from activeintent.runner import RunOptions
+    from activeintent.web.server import create_app, runner_builder
+    from activeintent.web.session import StudyConfig
+
+    try:
+        check_method(method)
+        # the hidden intention is resolved now so a typo fails before anyone opens the page
+        resolve_intention(intention or (None if intention_file else "color-match"), intention_file)
+    except (ValueError, IntentionError) as err:
+        raise typer.BadParameter(str(err)) from None
+    extra = dict(intention_file=intention_file, llm=llm, vlm=vlm, base_url=base_url, cache=cache,
+                 executor=executor, retriever=retriever)
+    RunOptions(method=method, rounds=rounds, intention=intention, **extra)  # validates the options
+    config = StudyConfig(method=method, signal=SIGNAL[method], rounds=rounds, intention=intention,
+                         show_estimate=show_estimate, out_dir=out, seed=seed,
+                         answer_timeout=answer_timeout, max_sessions=max_sessions)
+    app = create_app(config, runner_builder(config, **extra))
+    console = Console()
+    shown = "localhost" if host in ("127.0.0.1", "::1") else host
+    console.print(f"[bold]activeintent study[/]: {method} ({SIGNAL[method]} signal), {rounds} rounds; "
+                  f"sessions saved in {out}/")
+    console.print(f"Open http://{shown}:{port}/ — API schema at /openapi.json. Ctrl-C stops.")
+    if host not in ("127.0.0.1", "localhost", "::1"):
+        console.print(f"[yellow]Listening on {host}: anyone who can reach this address can take part.[/]")
+    uvicorn.run(app, host=host, port=port, log_level="warning")

@@ -1,0 +1,215 @@
+"""The human-in-the-loop web app: a JSON API under /api and plain HTML/JS pages.
+
+Pages: ``/`` (start), ``/preference`` (two videos, A / B / Can't choose / New scene),
+``/clicker`` (one video, Stop / Looks good / New scene) and ``/done`` (final execution and
+thank-you). Each page polls ``GET /api/sessions/{id}`` and answers with
+``POST /api/sessions/{id}/answer`` naming the round it answers.
+"""
+
+from __future__ import annotations
+
+import json
+from contextlib import asynccontextmanager
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from fastapi import FastAPI, HTTPException, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import FileResponse, JSONResponse
+from fastapi.staticfiles import StaticFiles
+from pydantic import BaseModel, Field, field_validator
+
+from activeintent.signals import PreferenceFeedback, StopFeedback
+from activeintent.users.human import AnswerRejected, Question, stop_feedback
+from activeintent.web.session import EpisodeBuilder, SessionManager, StudyConfig, WebSession
+
+STATIC = Path(__file__).parent / "static"
+PAGES = {"/": "index.html", "/preference": "preference.html", "/clicker": "clicker.html", "/done": "done.html"}
+
+
+# -- request bodies ---------------------------------------------------------------------------
+class NewSession(BaseModel):
+    participant: str | None = Field(None, max_length=100, description="optional participant code")
+    seed: int | None = Field(None, ge=0, le=2**31 - 1, description="seed of the episode (default: next)")
+
+
+class PreferenceAnswer(BaseModel):
+    kind: Literal["preference"]
+    round: int = Field(ge=1, description="the round this answers (as given in the session state)")
+    choice: Literal["A", "B", "cant_choose", "new_scene"]
+    client_ts: float | None = Field(None, allow_inf_nan=False, description="browser clock (s)")
+
+
+class StopAnswer(BaseModel):
+    kind: Literal["stop"]
+    round: int = Field(ge=1, description="the round this answers (as given in the session state)")
+    action: Literal["stop", "looks_good", "new_scene"]
+    time: float | None = Field(
+        None, allow_inf_nan=False, description="for action 'stop': the video's currentTime in seconds"
+    )
+    client_ts: float | None = Field(None, allow_inf_nan=False, description="browser clock (s)")
+
+
+Answer = Annotated[PreferenceAnswer | StopAnswer, Field(discriminator="kind")]
+
+
+class ClientEvent(BaseModel):
+    type: str = Field(min_length=1, max_length=64)
+    client_ts: float = Field(allow_inf_nan=False, description="the browser's clock, seconds since the epoch")
+    round: int | None = None
+    data: dict[str, Any] = Field(default_factory=dict)
+
+    @field_validator("data")
+    @classmethod
+    def _small(cls, v: dict) -> dict:
+        if len(json.dumps(v)) > 4000:
+            raise ValueError("event data is limited to 4000 characters of JSON")
+        return v
+
+
+class EventBatch(BaseModel):
+    events: list[ClientEvent] = Field(min_length=1, max_length=200)
+
+
+# -- the app ----------------------------------------------------------------------------------
+def _feedback_maker(session: WebSession, body: PreferenceAnswer | StopAnswer):
+    if body.kind != session.config.signal:
+        raise AnswerRejected(
+            f"this session asks for {session.config.signal} answers (kind '{session.config.signal}'), "
+            f"not '{body.kind}'",
+            status=422,
+        )
+
+    def make(q: Question) -> PreferenceFeedback | StopFeedback:
+        if isinstance(body, PreferenceAnswer):
+            return PreferenceFeedback(choice=body.choice)
+        if body.action == "stop":
+            if body.time is None:
+                raise AnswerRejected("action 'stop' needs 'time': the video time in seconds", status=422)
+            return stop_feedback(q.trajectories[0], body.time, session.config.fps)
+        if body.time is not None:
+            raise AnswerRejected(f"action '{body.action}' takes no 'time'", status=422)
+        if body.action == "new_scene":
+            return StopFeedback(new_scene=True)
+        return StopFeedback(stop_time=None)
+
+    return make
+
+
+def create_app(config: StudyConfig, builder: EpisodeBuilder | None = None) -> FastAPI:
+    """The app for one study. ``builder`` builds each session's episode; by default
+    :func:`activeintent.runner.build_episode` with the study's options."""
+    manager = SessionManager(config, builder or runner_builder(config))
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI):
+        yield
+        manager.shutdown()
+
+    app = FastAPI(
+        title="activeintent human-in-the-loop study",
+        description="A person gives the sparse signal h (preference or stop) that a learner learns from.",
+        version="1",
+        docs_url=None,  # the Swagger page loads scripts from a CDN; the schema is at /openapi.json
+        redoc_url=None,
+        lifespan=lifespan,
+    )
+    app.state.manager = manager
+
+    @app.exception_handler(AnswerRejected)
+    async def _rejected(request: Request, exc: AnswerRejected):
+        return JSONResponse({"detail": str(exc)}, status_code=exc.status)
+
+    @app.exception_handler(RequestValidationError)
+    async def _invalid(request: Request, exc: RequestValidationError):
+        problems = []
+        for err in exc.errors():
+            where = ".".join(str(p) for p in err.get("loc", ()) if p != "body")
+            problems.append(f"{where}: {err.get('msg')}" if where else str(err.get("msg")))
+        return JSONResponse(
+            {"detail": "invalid request: " + "; ".join(problems), "errors": json.loads(json.dumps(exc.errors(), default=str))},
+            status_code=422,
+        )
+
+    def session_or_404(sid: str) -> WebSession:
+        session = manager.get(sid)
+        if session is None:
+            raise HTTPException(404, f"unknown session {sid!r}")
+        return session
+
+    @app.get("/api/config", summary="The study's configuration (what every session runs)")
+    def get_config() -> dict:
+        return {
+            "method": config.method,
+            "signal": config.signal,
+            "rounds": config.rounds,
+            "intention": None,  # hidden from participants: it is what the learner must find
+            "show_estimate": config.show_estimate,
+            "fps": config.fps,
+        }
+
+    @app.post("/api/sessions", status_code=201, summary="Start a session (its episode starts at once)")
+    def create_session(body: NewSession | None = None) -> dict:
+        body = body or NewSession()
+        session = manager.create(participant=body.participant, seed=body.seed)
+        return session.state()
+
+    @app.get("/api/sessions/{sid}", summary="Session state: round i of K, the question, z, status")
+    def get_session(sid: str) -> dict:
+        return session_or_404(sid).state()
+
+    @app.post("/api/sessions/{sid}/answer", summary="Answer the waiting round (names the round)")
+    def post_answer(sid: str, body: Answer) -> dict:
+        session = session_or_404(sid)
+        client = {"client_ts": body.client_ts, **({"time": body.time} if isinstance(body, StopAnswer) else {})}
+        h = session.answer(body.round, _feedback_maker(session, body), client=client)
+        return {"accepted": True, "round": body.round, "feedback": h.model_dump()}
+
+    @app.post("/api/sessions/{sid}/events", summary="Append raw UI events (client timestamps kept)")
+    def post_events(sid: str, body: EventBatch) -> dict:
+        session = session_or_404(sid)
+        n = session.log_events([e.model_dump() for e in body.events])
+        return {"logged": n}
+
+    @app.get("/api/sessions/{sid}/result", summary="The episode's result (summary.json) once finished")
+    def get_result(sid: str) -> dict:
+        session = session_or_404(sid)
+        if session.result is None:
+            raise HTTPException(409, f"session {sid} is {session.status}; no result yet")
+        return session.result
+
+    @app.get("/api/sessions/{sid}/files/{name}", summary="A video of this session", response_class=FileResponse)
+    def get_file(sid: str, name: str):
+        session = session_or_404(sid)
+        path = session.file(name)
+        if path is None:
+            raise HTTPException(404, f"no file {name!r} in session {sid} (only its .webm/.gif videos are served)")
+        media = "video/webm" if path.suffix == ".webm" else "image/gif"
+        return FileResponse(path, media_type=media, headers={"Cache-Control": "no-store"})
+
+    for route, page in PAGES.items():
+        app.add_api_route(route, _page(page), methods=["GET"], include_in_schema=False)
+    app.mount("/static", StaticFiles(directory=STATIC), name="static")
+    return app
+
+
+def _page(name: str):
+    def serve_page():
+        return FileResponse(STATIC / name, media_type="text/html", headers={"Cache-Control": "no-store"})
+
+    return serve_page
+
+
+def runner_builder(config: StudyConfig, **options: Any) -> EpisodeBuilder:
+    """Sessions built by :func:`activeintent.runner.build_episode` (method, intention, rounds
+    from the study; ``options`` are further RunOptions fields, e.g. llm)."""
+    base = {"method": config.method, "rounds": config.rounds, **options}
+    if config.intention is not None:
+        base["intention"] = config.intention
+
+    def build(seed: int, out_dir: Path, user, on_round):
+        from activeintent.runner import RunOptions, build_episode
+
+        return build_episode(RunOptions(**base, seed=seed), out_dir, user=user, on_round=on_round)
+
+    return build

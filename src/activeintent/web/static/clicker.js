@@ -1,0 +1,105 @@
+// Clicker page: one video τ plays once; Stop records the media time of the frame on screen
+// (the server maps it to the trajectory tick); Looks good once it has ended; New scene.
+"use strict";
+
+(() => {
+  const video = document.getElementById("video");
+  const stopBtn = document.getElementById("stop");
+  const goodBtn = document.getElementById("good");
+  const newBtn = document.getElementById("new-scene");
+  const playBtn = document.getElementById("play");
+  const status = document.getElementById("status");
+  let round = null; // the round on screen and not yet answered
+  let shownRound = null;
+
+  Study.watchVideo(video, "robot", () => shownRound);
+
+  video.addEventListener("ended", () => {
+    if (round !== null) goodBtn.disabled = false;
+  });
+  playBtn.addEventListener("click", () => {
+    Study.log("play_clicked", {}, shownRound);
+    playBtn.classList.add("hidden");
+    video.play().catch(() => {});
+  });
+
+  function setEnabled(on) {
+    stopBtn.disabled = !on;
+    newBtn.disabled = !on;
+    goodBtn.disabled = !(on && video.ended);
+  }
+
+  async function send(action, via) {
+    if (round === null) return;
+    const answering = round;
+    round = null;
+    const body = { kind: "stop", round: answering, action, client_ts: Study.now() };
+    if (action === "stop") {
+      video.pause(); // freeze the frame the participant reacted to
+      body.time = video.currentTime;
+    }
+    setEnabled(false);
+    Study.log(action, { via, time: video.currentTime, duration: video.duration }, answering);
+    status.textContent = action === "stop" ? `Stopped at ${video.currentTime.toFixed(2)} s. Sending…` : "Sending…";
+    try {
+      await Study.api("POST", `/api/sessions/${Study.sessionId}/answer`, body);
+      Study.log("answer_accepted", { action, time: body.time ?? null }, answering);
+      status.textContent = action === "stop" ? `Stopped at ${body.time.toFixed(2)} s.` : "";
+      Study.setWaiting(true, "Thank you. The robot is thinking about what you showed it…");
+    } catch (err) {
+      Study.log("answer_rejected", { action, error: err.message }, answering);
+      status.textContent = `Not accepted: ${err.message}`;
+      round = answering;
+      setEnabled(true);
+    }
+    Study.flush();
+  }
+
+  stopBtn.addEventListener("click", () => send("stop", "click"));
+  goodBtn.addEventListener("click", () => send("looks_good", "click"));
+  newBtn.addEventListener("click", () => send("new_scene", "click"));
+  document.addEventListener("keydown", (e) => {
+    if (Study.isTyping(e) || e.repeat || e.ctrlKey || e.metaKey || e.altKey) return;
+    const k = e.key === " " ? "space" : e.key.toLowerCase();
+    const action = { space: "stop", g: "looks_good", n: "new_scene" }[k];
+    if (!action) return;
+    e.preventDefault(); // space must not scroll or press a focused button
+    Study.log("key", { key: k }, round);
+    if (action === "looks_good" && goodBtn.disabled) return;
+    send(action, "key");
+  });
+
+  function show(q) {
+    shownRound = q.round;
+    const v = q.videos[0];
+    playBtn.classList.add("hidden");
+    video.src = v.url;
+    video.load();
+    round = q.round;
+    setEnabled(true);
+    Study.setWaiting(false);
+    document.getElementById("question").dataset.round = String(q.round);
+    status.textContent = "";
+    Study.log("round_shown", { video: v.url, duration: v.duration, fps: v.fps }, q.round);
+    video.play().catch((err) => {
+      if (err.name === "NotAllowedError") playBtn.classList.remove("hidden"); // autoplay blocked
+    });
+  }
+
+  Study.log("page_load", { page: "clicker" });
+  Study.poll((s) => {
+    if (s.signal !== "stop") return Study.goTo("/preference");
+    if (Study.routeFinished(s)) return;
+    Study.setProgress(s);
+    Study.setEstimate(s);
+    if (s.status === "waiting-for-answer" && s.question && s.question.round !== shownRound) {
+      show(s.question);
+    } else if (s.status === "waiting-for-learner") {
+      round = null;
+      setEnabled(false);
+      Study.setWaiting(true, s.phase === "final"
+        ? "Thank you! The robot is now trying what it learned on a new table…"
+        : "The robot is thinking about what you showed it…");
+    }
+  });
+})();

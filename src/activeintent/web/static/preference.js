@@ -1,0 +1,95 @@
+// Preference page: two videos τ^a, τ^b side by side; the answer is A, B, Can't choose or New scene.
+"use strict";
+
+(() => {
+  const videos = { A: document.getElementById("video-a"), B: document.getElementById("video-b") };
+  const choiceButtons = [...document.querySelectorAll("button[data-choice]")];
+  const status = document.getElementById("status");
+  const keys = { a: "A", b: "B", c: "cant_choose", n: "new_scene" };
+  let round = null; // the round on screen and not yet answered
+  let shownRound = null;
+
+  Study.watchVideo(videos.A, "A", () => shownRound);
+  Study.watchVideo(videos.B, "B", () => shownRound);
+
+  function replay(which) {
+    Study.log("replay", { video: which }, shownRound);
+    for (const v of which === "both" ? [videos.A, videos.B] : [videos[which]]) {
+      v.currentTime = 0;
+      v.play().catch(() => {});
+    }
+  }
+  document.getElementById("replay-a").addEventListener("click", () => replay("A"));
+  document.getElementById("replay-b").addEventListener("click", () => replay("B"));
+  document.getElementById("replay-both").addEventListener("click", () => replay("both"));
+
+  function setEnabled(on) {
+    choiceButtons.forEach((b) => (b.disabled = !on));
+  }
+
+  async function answer(choice, via) {
+    if (round === null) return;
+    const answering = round;
+    round = null;
+    setEnabled(false);
+    Study.log("choice", { choice, via }, answering);
+    status.textContent = "Sending…";
+    try {
+      await Study.api("POST", `/api/sessions/${Study.sessionId}/answer`, {
+        kind: "preference", round: answering, choice, client_ts: Study.now(),
+      });
+      Study.log("answer_accepted", { choice }, answering);
+      status.textContent = "";
+      Object.values(videos).forEach((v) => v.pause());
+      Study.setWaiting(true, "Thank you. The robot is thinking about what to show you next…");
+    } catch (err) {
+      Study.log("answer_rejected", { choice, error: err.message }, answering);
+      status.textContent = `Not accepted: ${err.message}`;
+      round = answering;
+      setEnabled(true);
+    }
+    Study.flush();
+  }
+
+  choiceButtons.forEach((b) => b.addEventListener("click", () => answer(b.dataset.choice, "click")));
+  document.addEventListener("keydown", (e) => {
+    if (Study.isTyping(e) || e.repeat || e.ctrlKey || e.metaKey || e.altKey) return;
+    const choice = keys[e.key.toLowerCase()];
+    if (!choice) return;
+    Study.log("key", { key: e.key }, round);
+    e.preventDefault();
+    answer(choice, "key");
+  });
+
+  function show(q) {
+    shownRound = q.round;
+    for (const v of q.videos) {
+      const el = videos[v.label];
+      el.src = v.url;
+      el.load();
+      el.play().catch(() => {}); // muted autoplay is allowed; replay buttons otherwise
+    }
+    round = q.round;
+    setEnabled(true);
+    Study.setWaiting(false);
+    document.getElementById("question").dataset.round = String(q.round);
+    Study.log("round_shown", { videos: q.videos.map((v) => v.url) }, q.round);
+  }
+
+  Study.log("page_load", { page: "preference" });
+  Study.poll((s) => {
+    if (s.signal !== "preference") return Study.goTo("/clicker");
+    if (Study.routeFinished(s)) return;
+    Study.setProgress(s);
+    Study.setEstimate(s);
+    if (s.status === "waiting-for-answer" && s.question && s.question.round !== shownRound) {
+      show(s.question);
+    } else if (s.status === "waiting-for-learner") {
+      round = null;
+      setEnabled(false);
+      Study.setWaiting(true, s.phase === "final"
+        ? "Thank you! The robot is now trying what it learned on a new table…"
+        : "The robot is thinking about what to show you next…");
+    }
+  });
+})();

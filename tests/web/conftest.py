@@ -1,0 +1,98 @@
+"""A real study server (uvicorn on a free loopback port) and Debian's Chromium via Playwright."""
+
+from __future__ import annotations
+
+import os
+import socket
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import httpx
+import pytest
+import uvicorn
+
+from activeintent.learners.registry import SIGNAL
+from activeintent.web.server import create_app
+from activeintent.web.session import SessionManager, StudyConfig
+
+CHROMIUM = os.environ.get("ACTIVEINTENT_CHROMIUM", "/usr/bin/chromium")
+CHROMIUM_ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--no-first-run",
+    "--autoplay-policy=no-user-gesture-required",
+]
+
+
+@dataclass
+class LiveServer:
+    url: str
+    out: Path
+    manager: SessionManager
+    config: StudyConfig
+
+    def session_dir(self, sid: str) -> Path:
+        return self.out / sid
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture
+def live_server(tmp_path) -> Iterator:
+    """``start(method, rounds=2, **study)`` serves a study on 127.0.0.1 for this test."""
+    servers: list[tuple[uvicorn.Server, threading.Thread]] = []
+
+    def start(method: str, rounds: int = 2, **study) -> LiveServer:
+        out = tmp_path / f"out-{len(servers)}"
+        config = StudyConfig(method=method, signal=SIGNAL[method], rounds=rounds, out_dir=out, **study)
+        app = create_app(config)
+        port = _free_port()
+        server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
+        thread = threading.Thread(target=server.run, daemon=True)
+        thread.start()
+        url = f"http://127.0.0.1:{port}"
+        for _ in range(200):  # wait until it accepts connections
+            if server.started:
+                break
+            time.sleep(0.05)
+        assert server.started, "the study server did not start"
+        assert httpx.get(f"{url}/api/config").status_code == 200
+        servers.append((server, thread))
+        return LiveServer(url=url, out=out, manager=app.state.manager, config=config)
+
+    yield start
+    for server, thread in servers:
+        server.should_exit = True
+        thread.join(30)
+
+
+@pytest.fixture(scope="session")
+def browser():
+    if not Path(CHROMIUM).exists():
+        pytest.skip(f"{CHROMIUM} is missing: apt-get install chromium (bin/test does)")
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
+        yield b
+        b.close()
+
+
+@pytest.fixture
+def page(browser):
+    context = browser.new_context(viewport={"width": 1100, "height": 900})
+    pg = context.new_page()
+    pg.set_default_timeout(120_000)
+    yield pg
+    context.close()

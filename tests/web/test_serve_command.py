@@ -1,0 +1,71 @@
+"""`activeintent serve`: option errors before anything starts; a real server on loopback."""
+
+from __future__ import annotations
+
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import httpx
+from typer.testing import CliRunner
+
+from activeintent.cli import app
+
+
+def test_bad_options_fail_before_serving_and_list_the_valid_ones(tmp_path):
+    runner = CliRunner()
+    res = runner.invoke(app, ["serve", "--method", "clicks", "--out", str(tmp_path)])
+    assert res.exit_code != 0
+    assert "bayes-preference" in res.output and "mllm-llm" in res.output
+    res = runner.invoke(app, ["serve", "--method", "bayes-stop", "--intention", "nonsense", "--out", str(tmp_path)])
+    assert res.exit_code != 0 and "color-match" in res.output
+    assert not any(tmp_path.iterdir())  # nothing was started or saved
+
+
+def test_serve_binds_loopback_and_answers(tmp_path):
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    out = tmp_path / "study"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "activeintent.cli", "serve", "--port", str(port), "--method", "bayes-stop",
+         "--rounds", "3", "--hide-estimate", "--out", str(out)],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )
+    try:
+        config = None
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None:
+            try:
+                config = httpx.get(f"http://127.0.0.1:{port}/api/config", timeout=5).json()
+                break
+            except httpx.TransportError:
+                time.sleep(0.2)
+        assert config == {"method": "bayes-stop", "signal": "stop", "rounds": 3, "intention": None,
+                          "show_estimate": False, "fps": 10}
+        page = httpx.get(f"http://127.0.0.1:{port}/")
+        assert page.status_code == 200 and "Teach the robot" in page.text
+        listening = [c for c in _tcp_listeners() if c[1] == port]
+        assert listening and all(addr == "127.0.0.1" for addr, _ in listening), listening
+    finally:
+        proc.send_signal(signal.SIGINT)
+        output = proc.communicate(timeout=60)[0]
+    assert proc.returncode == 0, output
+    assert f"http://localhost:{port}/" in output
+
+
+def _tcp_listeners() -> list[tuple[str, int]]:
+    """(address, port) of the IPv4 sockets in LISTEN state, from /proc/net/tcp."""
+    found = []
+    with open("/proc/net/tcp") as f:
+        next(f)
+        for line in f:
+            local, state = line.split()[1], line.split()[3]
+            if state != "0A":
+                continue
+            hex_addr, hex_port = local.split(":")
+            addr = ".".join(str(int(hex_addr[i:i + 2], 16)) for i in (6, 4, 2, 0))
+            found.append((addr, int(hex_port, 16)))
+    return found

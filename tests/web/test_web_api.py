@@ -1,0 +1,247 @@
+"""The study server's JSON API against a live uvicorn server: good answers become h, every bad
+input gets a 4xx with a clear message and leaves the saved data untouched."""
+
+from __future__ import annotations
+
+import http.client
+import json
+import time
+from pathlib import Path
+from urllib.parse import urlsplit
+
+import httpx
+import pytest
+
+from activeintent.episode import read_rounds
+
+pytestmark = pytest.mark.slow  # real episodes: simulator, video export
+
+
+def wait_for(predicate, timeout: float = 180.0, what: str = "condition"):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.05)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+def waiting_state(url: str, sid: str, round: int) -> dict:
+    def ready():
+        s = httpx.get(f"{url}/api/sessions/{sid}").json()
+        assert s["status"] not in ("failed", "cancelled"), s["error"]
+        return s if s["status"] == "waiting-for-answer" and s["question"]["round"] == round else None
+
+    return wait_for(ready, what=f"round {round} of session {sid}")
+
+
+def snapshot(folder: Path) -> dict[str, bytes]:
+    return {p.name: p.read_bytes() for p in sorted(folder.iterdir()) if p.is_file()}
+
+
+def raw_get(url: str, path: str) -> tuple[int, str]:
+    """GET with the path sent byte for byte (no client-side normalisation of ../)."""
+    parts = urlsplit(url)
+    conn = http.client.HTTPConnection(parts.hostname, parts.port, timeout=30)
+    try:
+        conn.request("GET", path)
+        res = conn.getresponse()
+        return res.status, res.read().decode(errors="replace")
+    finally:
+        conn.close()
+
+
+def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server):
+    srv = live_server("bayes-preference", rounds=2, seed=5)
+    api = f"{srv.url}/api"
+    created = httpx.post(f"{api}/sessions", json={"participant": "api-test"})
+    assert created.status_code == 201
+    sid = created.json()["id"]
+    state = waiting_state(srv.url, sid, 1)
+    assert state["signal"] == "preference" and state["rounds"] == 2 and state["progress"] == 1
+    assert [v["label"] for v in state["question"]["videos"]] == ["A", "B"]
+    assert state["estimate"]  # the study shows z by default
+    for v in state["question"]["videos"]:
+        res = httpx.get(srv.url + v["url"])
+        assert res.status_code == 200 and res.headers["content-type"] == "video/webm"
+        assert res.content[:4] == b"\x1a\x45\xdf\xa3"  # EBML: a WebM file
+    folder = srv.session_dir(sid)
+    before = snapshot(folder)
+    answer = f"{api}/sessions/{sid}/answer"
+
+    bad = [
+        ({"kind": "preference", "round": 1, "choice": "C"}, 422, "'A', 'B', 'cant_choose' or 'new_scene'"),
+        ({"kind": "preference", "round": 1}, 422, "choice: Field required"),
+        ({"kind": "preference", "choice": "A"}, 422, "round: Field required"),
+        ({"kind": "preference", "round": 0, "choice": "A"}, 422, "greater than or equal to 1"),
+        ({"kind": "preference", "round": "one", "choice": "A"}, 422, "round"),
+        ({"kind": "vote", "round": 1, "choice": "A"}, 422, "'preference', 'stop'"),
+        ({"kind": "stop", "round": 1, "action": "looks_good"}, 422, "asks for preference answers"),
+        ({"kind": "preference", "round": 2, "choice": "A"}, 409, "waiting for round 1"),
+        ([1, 2, 3], 422, "invalid request"),
+    ]
+    for body, status, message in bad:
+        res = httpx.post(answer, json=body)
+        assert res.status_code == status, (body, res.text)
+        assert message in res.json()["detail"], (body, res.json())
+    res = httpx.post(answer, content=b"{not json", headers={"content-type": "application/json"})
+    assert res.status_code == 422 and "JSON" in res.json()["detail"]
+    assert snapshot(folder) == before, "a rejected answer changed the saved data"
+
+    ok = httpx.post(answer, json={"kind": "preference", "round": 1, "choice": "B", "client_ts": 1.0})
+    assert ok.status_code == 200 and ok.json()["feedback"]["choice"] == "B"
+    rounds = wait_for(lambda: read_rounds(folder / "rounds.jsonl"), what="rounds.jsonl")
+    assert rounds[0]["feedback"] == {"kind": "preference", "choice": "B"}
+
+    # the same answer again (a replay) is refused and the log keeps one round
+    after = snapshot(folder)
+    replay = httpx.post(answer, json={"kind": "preference", "round": 1, "choice": "A"})
+    assert replay.status_code == 409
+    assert "round 1" in replay.json()["detail"]
+    waiting_state(srv.url, sid, 2)
+    replay = httpx.post(answer, json={"kind": "preference", "round": 1, "choice": "A"})
+    assert replay.status_code == 409 and "waiting for round 2" in replay.json()["detail"]
+    assert read_rounds(folder / "rounds.jsonl") == rounds
+    assert (folder / "rounds.jsonl").read_bytes() == after["rounds.jsonl"]
+
+    # result only once finished
+    res = httpx.get(f"{api}/sessions/{sid}/result")
+    assert res.status_code == 409 and "no result yet" in res.json()["detail"]
+
+
+def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server):
+    srv = live_server("bayes-stop", rounds=1, seed=2)
+    api = f"{srv.url}/api"
+    sid = httpx.post(f"{api}/sessions").json()["id"]
+    state = waiting_state(srv.url, sid, 1)
+    video = state["question"]["videos"][0]
+    assert video["fps"] == 10 and video["frames"] >= 2
+    assert video["duration"] == pytest.approx(video["frames"] / video["fps"])
+    folder = srv.session_dir(sid)
+    before = snapshot(folder)
+    answer = f"{api}/sessions/{sid}/answer"
+    outside = [-0.5, video["duration"] + 0.5, 1e9]
+    for t in outside:
+        res = httpx.post(answer, json={"kind": "stop", "round": 1, "action": "stop", "time": t})
+        assert res.status_code == 422 and "outside the video" in res.json()["detail"], res.text
+    for raw in (b"NaN", b"Infinity", b"-Infinity", b'"soon"'):
+        body = b'{"kind": "stop", "round": 1, "action": "stop", "time": ' + raw + b"}"
+        res = httpx.post(answer, content=body, headers={"content-type": "application/json"})
+        assert res.status_code == 422, (raw, res.text)
+        assert "time" in res.json()["detail"]
+    for body, message in [
+        ({"kind": "stop", "round": 1, "action": "stop"}, "needs 'time'"),
+        ({"kind": "stop", "round": 1, "action": "looks_good", "time": 1.0}, "takes no 'time'"),
+        ({"kind": "stop", "round": 1, "action": "halt", "time": 1.0}, "'stop', 'looks_good' or 'new_scene'"),
+        ({"kind": "preference", "round": 1, "choice": "A"}, "asks for stop answers"),
+    ]:
+        res = httpx.post(answer, json=body)
+        assert res.status_code == 422 and message in res.json()["detail"], (body, res.text)
+    assert snapshot(folder) == before
+
+    t = 0.45  # media time → trajectory time 0.45 s: frame 4, tick round(0.45 / dt)
+    res = httpx.post(answer, json={"kind": "stop", "round": 1, "action": "stop", "time": t})
+    assert res.status_code == 200, res.text
+    h = res.json()["feedback"]
+    assert h["stop_time"] == pytest.approx(t) and h["frame"] == 4
+    session = srv.manager.get(sid)
+    assert session.join(300), "the episode did not finish"
+    assert session.status == "finished", session.error
+    rounds = read_rounds(folder / "rounds.jsonl")
+    assert len(rounds) == 1 and rounds[0]["feedback"] == h
+    summary = json.loads((folder / "summary.json").read_text())
+    assert summary["method"] == "bayes-stop" and summary["signals_used"] == 1
+    assert httpx.get(f"{api}/sessions/{sid}/result").json() == summary
+    assert (folder / "final.webm").stat().st_size > 0 and (folder / "round1_y.gif").exists()
+
+    # a finished session takes no answers; its saved data stays as it is
+    done = snapshot(folder)
+    res = httpx.post(answer, json={"kind": "stop", "round": 2, "action": "looks_good"})
+    assert res.status_code == 409 and "finished" in res.json()["detail"]
+    assert snapshot(folder) == done
+
+
+def test_unknown_sessions_path_traversal_and_isolation(live_server):
+    srv = live_server("bayes-preference", rounds=2, seed=1, max_sessions=2)
+    api = f"{srv.url}/api"
+    a = httpx.post(f"{api}/sessions").json()["id"]
+    b = httpx.post(f"{api}/sessions").json()["id"]
+    assert a != b
+    full = httpx.post(f"{api}/sessions")
+    assert full.status_code == 503 and "limit 2" in full.json()["detail"]
+    waiting_state(srv.url, a, 1)
+    waiting_state(srv.url, b, 1)
+    before_b = snapshot(srv.session_dir(b))
+
+    # answering session a leaves session b waiting for its own round 1
+    res = httpx.post(f"{api}/sessions/{a}/answer", json={"kind": "preference", "round": 1, "choice": "A"})
+    assert res.status_code == 200
+    waiting_state(srv.url, a, 2)
+    state_b = httpx.get(f"{api}/sessions/{b}").json()
+    assert state_b["question"]["round"] == 1 and state_b["rounds_answered"] == 0
+    assert snapshot(srv.session_dir(b)) == before_b
+
+    for sid in ("0123456789abcdef", "nope", "..", a.upper()):
+        for method, path, body in [
+            ("GET", f"/sessions/{sid}", None),
+            ("POST", f"/sessions/{sid}/answer", {"kind": "preference", "round": 1, "choice": "A"}),
+            ("POST", f"/sessions/{sid}/events", {"events": [{"type": "x", "client_ts": 1}]}),
+            ("GET", f"/sessions/{sid}/result", None),
+        ]:
+            res = httpx.request(method, api + path, json=body)
+            assert res.status_code == 404, (method, path, res.text)
+            assert "unknown session" in res.json()["detail"]
+
+    # only this session's videos are served: no other files, no other folders
+    ok, _ = raw_get(srv.url, f"/api/sessions/{a}/files/round1_a.webm")
+    assert ok == 200
+    secret = srv.out.parent / "secret.txt"
+    secret.write_text("not for participants")
+    attempts = [
+        f"/api/sessions/{a}/files/summary.json",
+        f"/api/sessions/{a}/files/events.jsonl",
+        f"/api/sessions/{a}/files/session.json",
+        f"/api/sessions/{a}/files/../{b}/round1_a.webm",
+        f"/api/sessions/{a}/files/..%2F{b}%2Fround1_a.webm",
+        f"/api/sessions/{a}/files/%2e%2e%2f{b}%2fround1_a.webm",
+        f"/api/sessions/{a}/files/%252e%252e%252f{b}%252fround1_a.webm",
+        f"/api/sessions/{a}/files/..%5c{b}%5cround1_a.webm",
+        f"/api/sessions/{a}/files/..%2F..%2Fsecret.txt",
+        f"/api/sessions/{a}/files/%2e%2e/%2e%2e/secret.txt",
+        f"/api/sessions/{a}/files/.%2e/.%2e/secret.txt",
+        "/static/../../secret.txt",
+        "/static/..%2F..%2F..%2Fpyproject.toml",
+        "/static/%2e%2e/server.py",
+        "/static/%2e%2e/%2e%2e/%2e%2e/%2e%2e/%2e%2e/etc/passwd",
+    ]
+    for path in attempts:
+        status, text = raw_get(srv.url, path)
+        assert status in (400, 404), (path, status)
+        assert "not for participants" not in text and "root:" not in text and "import" not in text
+
+    # the events of a session go to its own events.jsonl only
+    res = httpx.post(f"{api}/sessions/{b}/events",
+                     json={"events": [{"type": "probe", "client_ts": 1234.5, "round": 1, "data": {"k": 1}}]})
+    assert res.status_code == 200 and res.json() == {"logged": 1}
+    events_b = [json.loads(x) for x in (srv.session_dir(b) / "events.jsonl").read_text().splitlines()]
+    events_a = [json.loads(x) for x in (srv.session_dir(a) / "events.jsonl").read_text().splitlines()]
+    probe = [e for e in events_b if e["type"] == "probe"]
+    assert len(probe) == 1 and probe[0]["client_ts"] == 1234.5 and probe[0]["server_ts"] > 0
+    assert not [e for e in events_a if e["type"] == "probe"]
+    for body in ({"events": []}, {"events": [{"type": "", "client_ts": 1}]},
+                 {"events": [{"type": "x", "client_ts": 1, "data": {"blob": "x" * 5000}}]}):
+        res = httpx.post(f"{api}/sessions/{b}/events", json=body)
+        assert res.status_code == 422, res.text
+
+
+def test_openapi_describes_the_api(live_server):
+    srv = live_server("bayes-stop", rounds=1)
+    spec = httpx.get(f"{srv.url}/openapi.json").json()
+    paths = set(spec["paths"])
+    assert {"/api/config", "/api/sessions", "/api/sessions/{sid}", "/api/sessions/{sid}/answer",
+            "/api/sessions/{sid}/events", "/api/sessions/{sid}/result",
+            "/api/sessions/{sid}/files/{name}"} <= paths
+    config = httpx.get(f"{srv.url}/api/config").json()
+    assert config == {"method": "bayes-stop", "signal": "stop", "rounds": 1, "intention": None,
+                      "show_estimate": True, "fps": 10}
