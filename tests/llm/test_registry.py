@@ -88,3 +88,15 @@ def test_usage_snapshot_diff_gives_per_episode_totals():
     assert (episode.cache_hits, episode.cache_misses, episode.retries) == (1, 1, 2)
     assert episode.latency_s == pytest.approx(1.5)
     assert usage.snapshot().calls == 3
+
+
+def test_replay_needs_no_api_key(tmp_path, monkeypatch):
+    monkeypatch.delenv("OPENAI_API_KEY", raising=False)
+    monkeypatch.delenv("OPENAI_BASE_URL", raising=False)
+    path = tmp_path / "c.sqlite"
+    with FaultServer() as server:
+        server.default = Ok("recorded")
+        recorder = load_model("openai:gpt-x", base_url=server.base_url, cache_path=path)
+        assert recorder.chat([Message(role="user", content="q")]) == "recorded"
+    offline = load_model("openai:gpt-x", cache_path=path, cache_mode="replay")
+    assert offline.chat([Message(role="user", content="q")]) == "recorded"

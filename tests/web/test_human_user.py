@@ -52,8 +52,10 @@ SCENE = Scene(objects=["red block", "red bowl", "blue block"])
 def test_video_length_matches_frames_of_the_trajectory():
     traj = _trajectory()  # duration 3.0 s
     assert traj.duration == pytest.approx(3.0)
-    assert video_frames(traj.duration, 10) == 31  # frames at 0.0, 0.1, …, 3.0 s
+    assert video_frames(traj, 10) == 31  # frames at 0.0, 0.1, …, 3.0 s
     assert video_duration(traj, 10) == pytest.approx(3.1)
+    odd = _trajectory(n_ticks=178)  # 2.95 s: frames at 0.0, …, 2.9 and the last tick
+    assert video_frames(odd, 10) == 31 and video_duration(odd, 10) == pytest.approx(3.1)
 
 
 @pytest.mark.parametrize("t", [0.0, 0.05, 0.1, 0.35, 1.234, 1.6, 2.999, 3.0])

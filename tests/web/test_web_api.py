@@ -11,6 +11,7 @@ from urllib.parse import urlsplit
 
 import httpx
 import pytest
+from imageio_ffmpeg import count_frames_and_secs
 
 from activeintent.episode import read_rounds
 
@@ -66,6 +67,9 @@ def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server)
         res = httpx.get(srv.url + v["url"])
         assert res.status_code == 200 and res.headers["content-type"] == "video/webm"
         assert res.content[:4] == b"\x1a\x45\xdf\xa3"  # EBML: a WebM file
+        # the page's duration and frame count are the real file's
+        frames, secs = count_frames_and_secs(str(srv.session_dir(sid) / v["file"]))
+        assert frames == v["frames"] and secs == pytest.approx(v["duration"], abs=0.02)
     folder = srv.session_dir(sid)
     before = snapshot(folder)
     answer = f"{api}/sessions/{sid}/answer"

@@ -25,9 +25,9 @@ def register(app: typer.Typer) -> None:
         as_json: Annotated[bool, typer.Option("--json", help="print one JSON object")] = False,
     ) -> None:
         """Load time, tokens/s (free text and structured), mean latency of a learner-sized call."""
-        from activeintent.llm.speed import run_model_bench
         from activeintent.llm.embedded import EmbeddedConfig
         from activeintent.llm.registry import parse_spec
+        from activeintent.llm.speed import run_model_bench
 
         try:
             parse_spec(model)

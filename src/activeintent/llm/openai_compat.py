@@ -38,7 +38,6 @@ from activeintent.llm.retry import RetryOutcome, RetryPolicy, Transient, run_wit
 # "json_object_schema" is json_object plus a "schema" key, the form llama-cpp-python's server
 # takes (it turns the schema into a grammar).
 FORMAT_MODES = ("json_schema", "json_object_schema", "json_object", "text")
-_REFUSED = (openai.BadRequestError, openai.UnprocessableEntityError)
 DUMMY_API_KEY = "sk-no-key-needed"
 
 
@@ -132,8 +131,8 @@ class OpenAIBackend(Backend):
                 messages = with_instruction(messages, schema_instruction(request.json_schema or {}))
             try:
                 return self._complete_with_retry(request, encode_messages(messages), mode)
-            except _REFUSED as exc:
-                detail = _error_detail(exc)
+            except _Refused as exc:
+                detail = exc.detail
                 if "max_completion_tokens" in detail and self._max_tokens_field == "max_tokens":
                     self._max_tokens_field = "max_completion_tokens"
                     continue
@@ -165,22 +164,8 @@ class OpenAIBackend(Backend):
                 cause = exc.__cause__
                 refused = cause is not None and type(cause).__name__ == "ConnectError"
                 raise Transient(f"connection failed ({cause or exc})", unreachable=refused) from exc
-            except (openai.RateLimitError, openai.InternalServerError) as exc:
-                raise Transient(f"HTTP {exc.status_code}: {_error_detail(exc)}") from exc
             except openai.APIStatusError as exc:
-                if exc.status_code in (408, 409, 425):
-                    raise Transient(f"HTTP {exc.status_code}: {_error_detail(exc)}") from exc
-                if exc.status_code in (401, 403, 404):
-                    raise ModelUnavailableError(
-                        f"openai:{self.model_name} at {self.where}: HTTP {exc.status_code} "
-                        f"{_error_detail(exc)}"
-                    ) from exc
-                if exc.status_code in (400, 422):
-                    raise  # a refused request: complete() may try another format
-                raise ModelError(
-                    f"openai:{self.model_name} at {self.where}: HTTP {exc.status_code} "
-                    f"{_error_detail(exc)}"
-                ) from exc
+                raise self._classify(exc, format_requested=fmt is not None) from exc
             except (openai.APIResponseValidationError, json.JSONDecodeError) as exc:
                 raise Transient(f"malformed or truncated response body ({exc})") from exc
 
@@ -207,8 +192,29 @@ class OpenAIBackend(Backend):
             finish_reason=choice.finish_reason,
         )
 
+    def _classify(self, exc: openai.APIStatusError, *, format_requested: bool) -> Exception:
+        code, detail = exc.status_code, _error_detail(exc)
+        # Some servers answer an unknown response_format with 500 (llama-cpp-python's does):
+        # a refusal to try another format for, not a transient failure.
+        if code in (400, 422) or (format_requested and "response_format" in detail):
+            return _Refused(code, detail)
+        if code in (408, 409, 425, 429) or code >= 500:
+            return Transient(f"HTTP {code}: {detail}")
+        where = f"openai:{self.model_name} at {self.where}: HTTP {code} {detail}"
+        if code in (401, 403, 404):
+            return ModelUnavailableError(where)
+        return ModelError(where)
+
     def close(self) -> None:
         self.client.close()
+
+
+class _Refused(Exception):
+    """The server rejected the request itself (HTTP 400/422, or a refused response_format)."""
+
+    def __init__(self, code: int, detail: str) -> None:
+        super().__init__(f"HTTP {code}: {detail}")
+        self.detail = detail
 
 
 def _checked(response: Any) -> Any:

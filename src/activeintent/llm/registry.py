@@ -70,11 +70,16 @@ def load_model(
         path = cache if cache is not None else cache_path
         cache = ResponseCache(path, cache_mode) if cache_mode != "off" else None
     if parsed.kind == "openai":
-        from activeintent.llm.openai_compat import OpenAIBackend
+        import os
 
+        from activeintent.llm.openai_compat import DUMMY_API_KEY, OpenAIBackend
+
+        # Replaying a recorded cache needs no server and so no key.
+        offline = cache is not None and cache.mode == "replay" and not os.environ.get("OPENAI_API_KEY")
         backend = OpenAIBackend(
             parsed.target or "",
             base_url=base_url,
+            api_key=DUMMY_API_KEY if offline else None,
             timeout_s=timeout_s,
             retry=retry or RetryPolicy(seed=seed),
             seed=seed,

@@ -137,3 +137,46 @@ def create_object(client: int, name: str, position: tuple[float, float, float], 
     if kind_of(name) == "bowl":
         return create_bowl(client, name, position, collide)
     return create_block(client, name, position, collide)
+
+
+def light_panda_urdf() -> str:
+    """Path of a copy of pybullet_data's Panda whose visuals are its collision meshes.
+
+    The original visual meshes have ~100k triangles, which makes CPU rendering (and loading)
+    several times slower; the collision meshes keep the arm's shape at a fraction of that.
+    Written once to a cache directory (~/.cache/activeintent, or the temp dir).
+    """
+    import os
+    import tempfile
+    from pathlib import Path
+
+    import pybullet_data
+
+    data = Path(pybullet_data.getDataPath()) / "franka_panda"
+    text = (data / "panda.urdf").read_text()
+    text = text.replace("package://meshes/visual/", f"{data}/meshes/collision/")
+    text = text.replace("package://meshes/collision/", f"{data}/meshes/collision/")
+    for base in (Path.home() / ".cache" / "activeintent", Path(tempfile.gettempdir()) / "activeintent"):
+        try:
+            base.mkdir(parents=True, exist_ok=True)
+            path = base / f"panda_light_{abs(hash(text)) % 10**8}.urdf"
+            if not path.exists() or path.read_text() != text:
+                tmp = base / f".{path.name}.{os.getpid()}"
+                tmp.write_text(text)
+                tmp.replace(path)  # atomic: parallel benchmark processes may race here
+            return str(path)
+        except OSError:
+            continue
+    raise OSError("no writable cache directory for the Panda model")
+
+
+ARM_RGBA = (0.93, 0.93, 0.93, 1.0)
+HAND_RGBA = (0.30, 0.30, 0.32, 1.0)
+
+
+def color_panda(client: int, body: int) -> None:
+    """White arm, dark hand and fingers (the collision meshes carry no materials)."""
+    for link in range(-1, p.getNumJoints(body, physicsClientId=client)):
+        name = p.getJointInfo(body, link, physicsClientId=client)[12].decode() if link >= 0 else "base"
+        rgba = HAND_RGBA if ("hand" in name or "finger" in name) else ARM_RGBA
+        p.changeVisualShape(body, link, rgbaColor=rgba, physicsClientId=client)

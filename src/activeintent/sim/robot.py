@@ -12,6 +12,8 @@ import numpy as np
 import pybullet as p
 import pybullet_data
 
+from activeintent.sim.assets import light_panda_urdf
+
 PANDA_URDF = "franka_panda/panda.urdf"
 # Behind the middle of the top side of the workspace: every point of BOUNDS (plus the reach
 # margin) is reachable with the gripper pointing straight down (checked by tests/sim).
@@ -36,7 +38,7 @@ class Panda:
         self.client = client
         p.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=client)
         self.body = p.loadURDF(
-            PANDA_URDF, BASE_POSITION, p.getQuaternionFromEuler([0, 0, BASE_YAW]),
+            light_panda_urdf(), BASE_POSITION, p.getQuaternionFromEuler([0, 0, BASE_YAW]),
             useFixedBase=True, physicsClientId=client,
         )
         n = p.getNumJoints(self.body, physicsClientId=client)
@@ -51,7 +53,8 @@ class Panda:
         self.upper = [i[9] for i in info]
         self.ranges = [u - lo for lo, u in zip(self.lower, self.upper, strict=True)]
         self._grasp: int | None = None
-        self._grasp_offset: tuple[tuple[float, ...], tuple[float, ...]] | None = None
+        self._offset: np.ndarray | None = None
+        self._held_orn: tuple[float, ...] = (0.0, 0.0, 0.0, 1.0)
         self.grasped: int | None = None
         self.home = self.solve(HOME_EE, seeds=[REST_POSE])[0]
         self.set_joints(self.home)
@@ -79,63 +82,62 @@ class Panda:
         self.set_joints(q)
         return float(np.linalg.norm(self.ee_pose()[0] - target))
 
+    def _ik(self, target: np.ndarray, start: np.ndarray, orient: bool, null_space: bool) -> np.ndarray:
+        """One PyBullet IK call from ``start`` (it reads the body's joints; passing
+        currentPositions would ignore the rotated base pose in PyBullet 3.2)."""
+        self.set_joints(start)
+        kwargs: dict = {"maxNumIterations": 50, "residualThreshold": 1e-6, "physicsClientId": self.client}
+        if null_space:
+            kwargs.update(lowerLimits=self.lower, upperLimits=self.upper, jointRanges=self.ranges,
+                          restPoses=list(start))
+        args = (self.body, EE_LINK, target) + ((DOWN,) if orient else ())
+        return np.array(p.calculateInverseKinematics(*args, **kwargs))
+
     def solve(
         self, target: tuple[float, float, float] | np.ndarray, seeds: list | None = None,
         fingers: float = FINGER_OPEN,
     ) -> tuple[np.ndarray, float]:
-        """Joint positions putting the grasp point at ``target`` pointing down, and the
-        remaining position error (m). Starts from the current joints (continuity), then from
-        ``seeds``; the joint state is left unchanged."""
+        """Joint positions putting the grasp point at ``target`` and the remaining position
+        error (m); the joint state is left unchanged.
+
+        The gripper points straight down where it can. Close in front of the base the Panda
+        cannot do that, so the hand may tilt there (the grasp is suction-like: a held block
+        keeps its own orientation). Tries the current joints first (continuity while
+        tracking a path), then ``seeds``.
+        """
         target = np.asarray(target, dtype=float)
         saved = self.joints()
-        # Fast path while tracking a path: one damped-least-squares solve from the current
-        # joints is exact when the target is close to where the hand already is.
-        q = np.array(p.calculateInverseKinematics(
-            self.body, EE_LINK, target, DOWN, maxNumIterations=50, residualThreshold=1e-6,
-            physicsClientId=self.client,
-        ))
-        q[-2:] = fingers
-        if np.all(q >= self.lower) and np.all(q <= self.upper):
-            err = self._fk_error(q, target)
-            if err < 5e-4:
-                self.set_joints(saved)
-                return q, err
         starts = [saved] + [np.array([*s, fingers, fingers]) for s in (seeds or [])]
         best, best_err = saved, np.inf
-        for start in starts:
-            q = np.array(start, dtype=float)
-            # One pass pulled towards the start (keeps the arm's configuration), then plain
-            # damped least squares to remove the residual that the null-space pull leaves.
-            # (IK starts from the body's joint state: passing currentPositions ignores the
-            # base pose in PyBullet 3.2, so the joints are set instead.)
-            self.set_joints(q)
-            q = np.array(p.calculateInverseKinematics(
-                self.body, EE_LINK, target, DOWN, self.lower, self.upper, self.ranges, list(q),
-                maxNumIterations=50, residualThreshold=1e-5, physicsClientId=self.client,
-            ))
-            for _ in range(2):
-                self.set_joints(q)
-                q = np.array(p.calculateInverseKinematics(
-                    self.body, EE_LINK, target, DOWN, maxNumIterations=50,
-                    residualThreshold=1e-6, physicsClientId=self.client,
-                ))
-            q = np.clip(q, self.lower, self.upper)
-            q[-2:] = fingers
-            err = self._fk_error(q, target)
-            if err < best_err:
-                best, best_err = q, err
-            if best_err < 5e-4:
-                break
+        for orient in (True, False):
+            for i, start in enumerate(starts):
+                if i == 0:  # tracking: plain damped least squares from where the arm is
+                    q = self._ik(target, start, orient, null_space=False)
+                else:  # restart: keep the seed's configuration, then remove the residual
+                    q = self._ik(target, start, orient, null_space=True)
+                    q = self._ik(target, q, orient, null_space=False)
+                q[-2:] = fingers
+                if np.any(q < np.array(self.lower) - 1e-6) or np.any(q > np.array(self.upper) + 1e-6):
+                    q = np.clip(q, self.lower, self.upper)
+                err = self._fk_error(q, target)
+                if orient:
+                    tilt = 1.0 - abs(float(np.dot(self.ee_pose()[1], DOWN)))
+                    err += tilt  # a wrong orientation must not pass as a solution
+                if err < best_err:
+                    best, best_err = q, err
+                if best_err < 5e-4:
+                    self.set_joints(saved)
+                    return best, best_err
         self.set_joints(saved)
         return best, best_err
 
     # --- suction-style grasp ------------------------------------------------------------
     def grasp(self, body: int) -> None:
-        """Hold ``body`` rigidly at its current pose relative to the hand."""
-        pos, orn = self.ee_pose()
+        """Hold ``body`` at its current offset from the grasp point; it keeps its orientation."""
+        pos, _ = self.ee_pose()
         bpos, born = p.getBasePositionAndOrientation(body, physicsClientId=self.client)
-        inv = p.invertTransform(pos, orn)
-        self._grasp_offset = p.multiplyTransforms(*inv, bpos, born)
+        self._offset = np.array(bpos) - pos
+        self._held_orn = born
         self._grasp = p.createConstraint(
             body, -1, -1, -1, p.JOINT_FIXED, (0, 0, 0), (0, 0, 0), bpos,
             childFrameOrientation=born, physicsClientId=self.client,
@@ -144,22 +146,21 @@ class Panda:
         self.grasped = body
 
     def grasp_offset_world(self) -> np.ndarray:
-        """Where the held body's centre is relative to the grasp point, in world axes."""
-        assert self._grasp_offset is not None
-        return np.array(p.multiplyTransforms((0, 0, 0), DOWN, self._grasp_offset[0], (0, 0, 0, 1))[0])
+        """Where the held body's centre is relative to the grasp point (world axes)."""
+        assert self._offset is not None
+        return self._offset.copy()
 
     def follow(self) -> None:
-        """Move the grasp constraint's anchor to the hand (call after each joint update)."""
-        if self._grasp is None or self._grasp_offset is None:
+        """Move the grasp constraint's anchor with the hand (call after each joint update)."""
+        if self._grasp is None or self._offset is None:
             return
-        pos, orn = self.ee_pose()
-        tpos, torn = p.multiplyTransforms(pos, orn, *self._grasp_offset)
+        pos, _ = self.ee_pose()
         p.changeConstraint(
-            self._grasp, jointChildPivot=tpos, jointChildFrameOrientation=torn, maxForce=200.0,
-            physicsClientId=self.client,
+            self._grasp, jointChildPivot=(pos + self._offset).tolist(),
+            jointChildFrameOrientation=self._held_orn, maxForce=200.0, physicsClientId=self.client,
         )
 
     def release(self) -> None:
         if self._grasp is not None:
             p.removeConstraint(self._grasp, physicsClientId=self.client)
-        self._grasp = self._grasp_offset = self.grasped = None
+        self._grasp = self._offset = self.grasped = None

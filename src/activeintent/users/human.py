@@ -55,15 +55,17 @@ class Question:
     asked_at: float = field(default_factory=time.time)
 
 
-def video_frames(duration: float, fps: int) -> int:
-    """Frames in a video of a trajectory lasting ``duration`` s: one per 1/fps s, both ends
-    included (frame k shows trajectory time k / fps)."""
-    return int(math.floor(duration * fps + 1e-9)) + 1
+def video_frames(traj: Trajectory, fps: int) -> int:
+    """Frames of the exported video of τ: one per 1/fps s from 0, plus the last tick when the
+    duration is not a whole number of frames (``activeintent.sim.video.frame_times``)."""
+    from activeintent.sim.video import frame_times
+
+    return len(frame_times(traj, fps))
 
 
 def video_duration(traj: Trajectory, fps: int) -> float:
     """Media length in seconds of the exported video: each frame is shown for 1/fps s."""
-    return video_frames(traj.duration, fps) / fps
+    return video_frames(traj, fps) / fps
 
 
 def stop_feedback(traj: Trajectory, t: float, fps: int) -> StopFeedback:

@@ -202,7 +202,7 @@ class WebSession:
             file=f"{name}.webm",
             url=f"/api/sessions/{self.id}/files/{name}.webm",
             fps=fps,
-            frames=video_frames(traj.duration, fps),
+            frames=video_frames(traj, fps),
             duration=video_duration(traj, fps),
             trajectory_duration=traj.duration,
         )

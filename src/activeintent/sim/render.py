@@ -1,0 +1,111 @@
+"""Frames rendered on demand from a trajectory log (no video is recorded while simulating).
+
+A renderer rebuilds the scene with visual-only bodies in its own PyBullet DIRECT client
+(cached per scene), poses objects and joints from the logged tick and draws with the CPU
+TinyRenderer, so I_0, I_b and I_s can be produced for any time t.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+
+import numpy as np
+import pybullet as p
+import pybullet_data
+
+from activeintent.sim.assets import color_panda, create_object, create_table, light_panda_urdf
+from activeintent.sim.robot import BASE_POSITION, BASE_YAW, REST_POSE
+from activeintent.sim.trajectory import Trajectory
+from activeintent.world.state import WorldState
+
+# An oblique view from the front edge of the table towards the robot, as in Code as Policies:
+# the top side of the workspace (near the robot) is at the top of the image, x grows to the right.
+CAMERA_EYE = (0.0, -1.13, 0.62)
+CAMERA_TARGET = (0.0, -0.5, 0.0)
+CAMERA_UP = (0.0, 0.0, 1.0)
+CAMERA_FOV = 44.0
+LIGHT_DIRECTION = (0.3, -0.6, 1.0)
+_MAX_CACHED = 4
+
+
+class SceneRenderer:
+    """Visual copy of one scene (objects in a fixed order) in its own client."""
+
+    def __init__(self, object_names: list[str]):
+        self.client = p.connect(p.DIRECT)
+        c = self.client
+        p.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=c)
+        create_table(c, collide=False)
+        self.robot = p.loadURDF(
+            light_panda_urdf(), BASE_POSITION, p.getQuaternionFromEuler([0, 0, BASE_YAW]),
+            useFixedBase=True, physicsClientId=c,
+        )
+        color_panda(c, self.robot)
+        n = p.getNumJoints(self.robot, physicsClientId=c)
+        self.movable = [
+            j for j in range(n) if p.getJointInfo(self.robot, j, physicsClientId=c)[2] != p.JOINT_FIXED
+        ]
+        self.object_names = list(object_names)
+        self.bodies = [create_object(c, name, (0.0, 0.0, -1.0), collide=False) for name in object_names]
+        self.view = p.computeViewMatrix(CAMERA_EYE, CAMERA_TARGET, CAMERA_UP)
+
+    def close(self) -> None:
+        if self.client >= 0:
+            p.disconnect(physicsClientId=self.client)
+            self.client = -1
+
+    def draw(self, poses: np.ndarray, joints: np.ndarray | None, size: tuple[int, int]) -> np.ndarray:
+        """``poses`` [N, 7] (xyz + quaternion) in object order; ``joints`` for the arm."""
+        c = self.client
+        for body, pose in zip(self.bodies, poses, strict=True):
+            p.resetBasePositionAndOrientation(body, pose[:3].tolist(), pose[3:7].tolist(), physicsClientId=c)
+        if joints is None:
+            joints = np.array([*REST_POSE, 0.04, 0.04])
+        p.resetJointStatesMultiDof(self.robot, self.movable, [[float(v)] for v in joints], physicsClientId=c)
+        w, h = size
+        proj = p.computeProjectionMatrixFOV(CAMERA_FOV, w / h, 0.05, 5.0)
+        _, _, rgba, _, _ = p.getCameraImage(
+            w, h, self.view, proj, shadow=0, lightDirection=LIGHT_DIRECTION,
+            renderer=p.ER_TINY_RENDERER, flags=p.ER_NO_SEGMENTATION_MASK, physicsClientId=c,
+        )
+        return np.asarray(rgba, dtype=np.uint8).reshape(h, w, 4)[:, :, :3].copy()
+
+
+_cache: OrderedDict[tuple[str, ...], SceneRenderer] = OrderedDict()
+
+
+def renderer_for(object_names: list[str]) -> SceneRenderer:
+    """The cached renderer of a scene (least recently used ones are closed)."""
+    key = tuple(object_names)
+    if key in _cache:
+        _cache.move_to_end(key)
+        return _cache[key]
+    renderer = _cache[key] = SceneRenderer(list(object_names))
+    while len(_cache) > _MAX_CACHED:
+        _cache.popitem(last=False)[1].close()
+    return renderer
+
+
+def _check_size(size: tuple[int, int]) -> tuple[int, int]:
+    w, h = int(size[0]), int(size[1])
+    if not (16 <= w <= 2048 and 16 <= h <= 2048):
+        raise ValueError(f"image size must be between 16 and 2048 pixels per side, got {size}")
+    return w, h
+
+
+def render_frame(traj: Trajectory, t: float, size: tuple[int, int] = (240, 240)) -> np.ndarray:
+    """RGB image (H, W, 3) uint8 of τ at time t seconds (clipped to the trajectory)."""
+    size = _check_size(size)
+    if traj.n_ticks == 0:
+        raise ValueError("the trajectory has no ticks to render")
+    tick = traj.tick_at(t)
+    renderer = renderer_for(traj.object_names)
+    return renderer.draw(traj.object_poses[tick], traj.joint_positions[tick], size)
+
+
+def render_state(state: WorldState, size: tuple[int, int] = (240, 240)) -> np.ndarray:
+    """RGB image of a world state (objects upright, arm in its rest pose), e.g. a scene's I_0."""
+    size = _check_size(size)
+    names = state.names
+    poses = np.array([[*state.positions[n], 0.0, 0.0, 0.0, 1.0] for n in names])
+    return renderer_for(names).draw(poses, None, size)

@@ -1,0 +1,57 @@
+"""Export τ as a GIF, WebM (VP9) or MP4 (H.264), frames sampled from the log at ``fps``."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from activeintent.sim.render import render_frame
+from activeintent.sim.trajectory import Trajectory
+
+FORMATS = (".gif", ".webm", ".mp4")
+
+
+def frame_times(traj: Trajectory, fps: float) -> np.ndarray:
+    """Times of the exported frames: every 1/fps seconds, always including the last tick."""
+    if fps <= 0:
+        raise ValueError(f"fps must be positive, got {fps}")
+    times = np.arange(0.0, traj.duration + 1e-9, 1.0 / fps)
+    if traj.duration - times[-1] > 1e-6:
+        times = np.append(times, traj.duration)
+    return times
+
+
+def export_video(
+    traj: Trajectory, path: str | Path, fps: float = 10, size: tuple[int, int] = (240, 240),
+    progress: Callable[[int, int], None] | None = None,
+) -> Path:
+    """Write ``path`` (.gif, .webm or .mp4, by suffix); ``progress(done, total)`` per frame."""
+    import imageio.v2 as iio
+
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in FORMATS:
+        raise ValueError(f"unsupported video format {suffix!r}; use one of {', '.join(FORMATS)}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    times = frame_times(traj, fps)
+    if suffix == ".gif":
+        writer = iio.get_writer(path, mode="I", duration=1000.0 / fps, loop=0)
+    else:
+        codec = "libvpx-vp9" if suffix == ".webm" else "libx264"
+        extra = ["-b:v", "0", "-crf", "34", "-deadline", "realtime", "-cpu-used", "8"] if suffix == ".webm" else [
+            "-preset", "veryfast", "-crf", "23"
+        ]
+        writer = iio.get_writer(
+            path, format="FFMPEG", mode="I", fps=fps, codec=codec, pixelformat="yuv420p",
+            macro_block_size=2, output_params=extra, ffmpeg_log_level="error",
+        )
+    try:
+        for i, t in enumerate(times):
+            writer.append_data(render_frame(traj, float(t), size=size))
+            if progress:
+                progress(i + 1, len(times))
+    finally:
+        writer.close()
+    return path
