@@ -91,3 +91,16 @@ def test_gguf_spec_loads_any_file(gguf_path):
     other = load_model(f"gguf:{gguf_path}", cache_mode="off")
     assert other.name.startswith(f"llama.cpp:{gguf_path.name}@")
     assert isinstance(other.structured(ASK, Pick, max_tokens=48), Pick)
+
+
+def test_grammar_keeps_field_order_and_forbids_raw_control_characters():
+    import json
+
+    from activeintent.llm.embedded import _grammar_text
+
+    gbnf = _grammar_text(json.dumps(Pick.model_json_schema()))
+    root = next(line for line in gbnf.splitlines() if line.startswith("root ::="))
+    assert root.index("color-kv") < root.index("count-kv")
+    text = _grammar_text(json.dumps({"type": "object", "properties": {"s": {"type": "string"}}}))
+    char = next(line for line in text.splitlines() if line.startswith("char ::="))
+    assert r"\x00-\x1F" in char

@@ -112,7 +112,7 @@ def parse_structured(text: str, schema: type[T]) -> T:
     """Validate ``text`` against ``schema``; a ValueError says why it failed, in words."""
     candidate = extract_json(text)
     try:
-        data = json.loads(candidate)
+        data = json.loads(candidate, strict=False)  # tolerate raw newlines inside strings
     except json.JSONDecodeError as exc:
         raise ValueError(f"it is not valid JSON ({exc.msg} at character {exc.pos})") from exc
     try:

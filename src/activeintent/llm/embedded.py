@@ -38,6 +38,11 @@ class EmbeddedConfig(BaseModel):
     n_batch: int = Field(default=512, ge=8)
     seed: int = 0
     model_dir: Path = Field(default_factory=default_model_dir)
+    reuse_prefix: bool = Field(
+        default=False,
+        description="keep the KV cache of the previous prompt's shared prefix (faster for "
+        "growing histories, but an answer may then depend on the call before it)",
+    )
 
 
 def default_gguf(model_dir: Path | None = None) -> Path:
@@ -61,8 +66,10 @@ def default_gguf(model_dir: Path | None = None) -> Path:
     return target
 
 
-# Loading takes seconds: one Llama per (path, settings) per process.
+# Loading takes seconds: one Llama per (path, settings) per process, with one lock each
+# (a Llama holds one KV cache, so one call at a time, whichever backend object makes it).
 _LOADED: dict[tuple, Any] = {}
+_CALL_LOCKS: dict[int, threading.Lock] = {}
 _LOAD_LOCK = threading.Lock()
 
 
@@ -87,14 +94,26 @@ def load_llama(path: Path, config: EmbeddedConfig) -> Any:
                 )
             except ValueError as exc:  # llama-cpp-python's "Failed to load model from file"
                 raise ModelUnavailableError(f"cannot load GGUF model {path}: {exc}") from exc
+            _CALL_LOCKS[id(_LOADED[key])] = threading.Lock()
         return _LOADED[key]
+
+
+_LOOSE_CHAR = r'char ::= [^"\\] |'
+_JSON_CHAR = r'char ::= [^"\\\x7F\x00-\x1F] |'
 
 
 @lru_cache(maxsize=64)
 def _grammar_text(schema_json: str) -> str:
+    """GBNF for a JSON schema (property order kept: the model writes fields in that order)."""
     from llama_cpp.llama_grammar import json_schema_to_gbnf
 
-    return json_schema_to_gbnf(schema_json)
+    gbnf = json_schema_to_gbnf(schema_json)
+    # llama-cpp-python's string character rule admits raw control characters (newlines),
+    # which JSON forbids inside strings; use JSON's own rule.
+    return "\n".join(
+        _JSON_CHAR + line[len(_LOOSE_CHAR) :] if line.startswith(_LOOSE_CHAR) else line
+        for line in gbnf.split("\n")
+    )
 
 
 def plain_prompt(messages: list[Message]) -> str:
@@ -148,7 +167,7 @@ class EmbeddedBackend(Backend):
         self.prompt_format = "chat_template" if self.has_chat_template else (
             "turns" if self._has_turn_markers() else "plain"
         )
-        self._lock = threading.Lock()  # a Llama holds one KV cache: one call at a time
+        self._lock = _CALL_LOCKS[id(self.llama)]
 
     def _has_turn_markers(self) -> bool:
         return all(
@@ -161,11 +180,13 @@ class EmbeddedBackend(Backend):
 
         grammar = None
         if request.json_schema is not None:
-            schema_json = json.dumps(request.json_schema, sort_keys=True)
+            schema_json = json.dumps(request.json_schema)
             grammar = LlamaGrammar.from_string(_grammar_text(schema_json), verbose=False)
         with self._lock:
-            # Evaluate every prompt from scratch: answers never depend on the previous call.
-            self.llama.reset()
+            if not self.config.reuse_prefix:
+                # Evaluate every prompt from scratch: an answer is a function of its request
+                # alone, as the content-addressed cache assumes.
+                self.llama.reset()
             try:
                 if self.has_chat_template:
                     out = self.llama.create_chat_completion(

@@ -17,13 +17,13 @@ from collections.abc import Sequence
 
 import numpy as np
 import pybullet as p
-from pydantic import BaseModel, Field, TypeAdapter, model_validator
+from pydantic import BaseModel, Field, TypeAdapter, ValidationError, model_validator
 
 from activeintent.sim.assets import create_object, create_table
 from activeintent.sim.robot import FINGER_CLOSED, FINGER_OPEN, HOME_EE, SEED_POSES, Panda
 from activeintent.sim.trajectory import StepRecord, Trajectory
 from activeintent.world.predict import SkillFailure, target_position
-from activeintent.world.scene import BLOCK_SIZE, BOWL_HEIGHT, Scene, kind_of, layout
+from activeintent.world.scene import BLOCK_SIZE, BOWL_HEIGHT, Scene, SceneError, kind_of, layout
 from activeintent.world.skills import Skill
 from activeintent.world.state import WorldState
 
@@ -35,8 +35,8 @@ class SimConfig(BaseModel):
 
     physics_hz: int = Field(240, ge=60, description="physics steps per simulated second")
     log_hz: int = Field(60, ge=1, description="rows of the trajectory log per second (1/dt)")
-    travel_speed: float = Field(0.45, gt=0, description="hand speed when moving over the table")
-    vertical_speed: float = Field(0.25, gt=0, description="hand speed when descending or lifting")
+    travel_speed: float = Field(0.5, gt=0, description="hand speed when moving over the table")
+    vertical_speed: float = Field(0.3, gt=0, description="hand speed when descending or lifting")
     min_segment_s: float = Field(0.25, ge=0, description="shortest duration of one motion segment")
     grasp_s: float = Field(0.15, ge=0, description="pause while the gripper closes")
     release_s: float = Field(0.15, ge=0, description="pause while the gripper opens")
@@ -48,6 +48,7 @@ class SimConfig(BaseModel):
     failure_pause_s: float = Field(0.3, ge=0, description="idle time logged for a failed step")
     home_at_end: bool = Field(True, description="return to the home pose after a plan (clear last frame)")
     place_tolerance: float = Field(0.02, gt=0, description="a block ending farther from its target fails")
+    solver_iterations: int = Field(30, ge=5, description="constraint solver iterations per physics step")
     ik_tolerance: float = Field(0.005, gt=0, description="largest IK error at a pick or place pose")
 
     @model_validator(mode="after")
@@ -81,7 +82,9 @@ class TabletopEnv:
 
     def __init__(self, config: SimConfig | None = None):
         self.config = config or SimConfig()
-        self.client = p.connect(p.DIRECT)
+        self.client = p.connect(p.DIRECT)  # physics: table, bowls, blocks
+        self._arm_client = p.connect(p.DIRECT)  # the kinematic arm (IK / FK), kept across resets
+        self._arm = Panda(self._arm_client, world=self.client)
         self.robot: Panda | None = None
         self.scene: Scene | None = None
         self.seed: int | None = None
@@ -100,6 +103,7 @@ class TabletopEnv:
     def close(self) -> None:
         if self.client >= 0:
             p.disconnect(physicsClientId=self.client)
+            p.disconnect(physicsClientId=self._arm_client)
             self.client = -1
 
     def __del__(self) -> None:
@@ -112,7 +116,11 @@ class TabletopEnv:
         """Rebuild the world with ``scene`` laid out from ``seed``; returns the settled state."""
         if self.client < 0:
             raise RuntimeError("this TabletopEnv is closed; create a new one")
-        scene = scene if isinstance(scene, Scene) else Scene(objects=list(scene))
+        if not isinstance(scene, Scene):
+            try:
+                scene = Scene(objects=list(scene))
+            except ValidationError as e:  # surface the scene's own message, not pydantic's
+                raise SceneError("; ".join(err["msg"].removeprefix("Value error, ") for err in e.errors())) from None
         return self._build(scene, layout(scene, seed), seed)
 
     def reset_to(self, state: WorldState, seed: int = 0) -> WorldState:
@@ -126,12 +134,13 @@ class TabletopEnv:
         # A fresh world each time: PyBullet is deterministic only for identical call sequences.
         p.resetSimulation(physicsClientId=c)
         p.setPhysicsEngineParameter(
-            fixedTimeStep=1.0 / self.config.physics_hz, numSolverIterations=50,
+            fixedTimeStep=1.0 / self.config.physics_hz, numSolverIterations=self.config.solver_iterations,
             deterministicOverlappingPairs=1, physicsClientId=c,
         )
         p.setGravity(0, 0, -9.81, physicsClientId=c)
         create_table(c)
-        self.robot = Panda(c)
+        self._arm.reset()
+        self.robot = self._arm
         self.bodies = {name: create_object(c, name, positions[name]) for name in scene.objects}
         self.scene, self.seed = scene, seed
         for _ in range(round(self.config.initial_settle_s * self.config.physics_hz)):
@@ -171,9 +180,15 @@ class TabletopEnv:
     def _advance(self, q_from: np.ndarray, q_to: np.ndarray) -> None:
         """One log tick: joints interpolated over the physics substeps, objects simulated."""
         robot = self._require()
+        held = robot.grasped is not None
+        if held:  # the held block's anchor moves with the hand, interpolated per substep
+            start = robot.ee_pose()[0]
+            robot.set_joints(q_to)
+            end = robot.ee_pose()[0]
+        robot.set_joints(q_to)
         for k in range(1, self._substeps + 1):
-            robot.set_joints(q_from + (q_to - q_from) * (k / self._substeps))
-            robot.follow()
+            if held:
+                robot.follow(start + (end - start) * (k / self._substeps))
             p.stepSimulation(physicsClientId=self.client)
         self._record()
 

@@ -20,10 +20,10 @@ from activeintent.world.state import WorldState
 
 # An oblique view from the front edge of the table towards the robot, as in Code as Policies:
 # the top side of the workspace (near the robot) is at the top of the image, x grows to the right.
-CAMERA_EYE = (0.0, -1.13, 0.62)
-CAMERA_TARGET = (0.0, -0.5, 0.0)
+CAMERA_EYE = (0.0, -1.28, 0.78)
+CAMERA_TARGET = (0.0, -0.49, 0.0)
 CAMERA_UP = (0.0, 0.0, 1.0)
-CAMERA_FOV = 44.0
+CAMERA_FOV = 45.0
 LIGHT_DIRECTION = (0.3, -0.6, 1.0)
 _MAX_CACHED = 4
 

@@ -32,10 +32,14 @@ HOME_EE = (0.0, -0.28, 0.42)
 
 
 class Panda:
-    """A kinematically driven Panda in one PyBullet client."""
+    """A kinematically driven Panda."""
 
-    def __init__(self, client: int):
+    def __init__(self, client: int, world: int | None = None):
+        """The arm lives in ``client`` (kinematics only); held objects live in ``world``
+        (the physics client; the same one if not given). Keeping the arm out of the physics
+        world makes each physics step cheaper: it never touches anything anyway."""
         self.client = client
+        self.world = client if world is None else world
         p.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=client)
         self.body = p.loadURDF(
             light_panda_urdf(), BASE_POSITION, p.getQuaternionFromEuler([0, 0, BASE_YAW]),
@@ -86,7 +90,10 @@ class Panda:
         """One PyBullet IK call from ``start`` (it reads the body's joints; passing
         currentPositions would ignore the rotated base pose in PyBullet 3.2)."""
         self.set_joints(start)
-        kwargs: dict = {"maxNumIterations": 50, "residualThreshold": 1e-6, "physicsClientId": self.client}
+        kwargs: dict = {
+            "maxNumIterations": 50, "residualThreshold": 1e-5,
+            "physicsClientId": self.client,
+        }
         if null_space:
             kwargs.update(lowerLimits=self.lower, upperLimits=self.upper, jointRanges=self.ranges,
                           restPoses=list(start))
@@ -135,14 +142,14 @@ class Panda:
     def grasp(self, body: int) -> None:
         """Hold ``body`` at its current offset from the grasp point; it keeps its orientation."""
         pos, _ = self.ee_pose()
-        bpos, born = p.getBasePositionAndOrientation(body, physicsClientId=self.client)
+        bpos, born = p.getBasePositionAndOrientation(body, physicsClientId=self.world)
         self._offset = np.array(bpos) - pos
         self._held_orn = born
         self._grasp = p.createConstraint(
             body, -1, -1, -1, p.JOINT_FIXED, (0, 0, 0), (0, 0, 0), bpos,
-            childFrameOrientation=born, physicsClientId=self.client,
+            childFrameOrientation=born, physicsClientId=self.world,
         )
-        p.changeConstraint(self._grasp, maxForce=200.0, physicsClientId=self.client)
+        p.changeConstraint(self._grasp, maxForce=200.0, physicsClientId=self.world)
         self.grasped = body
 
     def grasp_offset_world(self) -> np.ndarray:
@@ -150,17 +157,24 @@ class Panda:
         assert self._offset is not None
         return self._offset.copy()
 
-    def follow(self) -> None:
-        """Move the grasp constraint's anchor with the hand (call after each joint update)."""
+    def follow(self, pos: np.ndarray | None = None) -> None:
+        """Move the grasp constraint's anchor with the hand (grasp point ``pos``, default:
+        where the hand is now)."""
         if self._grasp is None or self._offset is None:
             return
-        pos, _ = self.ee_pose()
+        if pos is None:
+            pos, _ = self.ee_pose()
         p.changeConstraint(
             self._grasp, jointChildPivot=(pos + self._offset).tolist(),
-            jointChildFrameOrientation=self._held_orn, maxForce=200.0, physicsClientId=self.client,
+            jointChildFrameOrientation=self._held_orn, maxForce=200.0, physicsClientId=self.world,
         )
+
+    def reset(self) -> None:
+        """Back to the home pose, holding nothing (the world may have been rebuilt)."""
+        self._grasp = self._offset = self.grasped = None
+        self.set_joints(self.home)
 
     def release(self) -> None:
         if self._grasp is not None:
-            p.removeConstraint(self._grasp, physicsClientId=self.client)
+            p.removeConstraint(self._grasp, physicsClientId=self.world)
         self._grasp = self._offset = self.grasped = None
