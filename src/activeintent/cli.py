@@ -20,6 +20,7 @@ _COMMAND_MODULES = (
     "activeintent.act.commands",
     "activeintent.bench.commands",
     "activeintent.intentions.commands",
+    "activeintent.learners.bayes.commands",
     "activeintent.llm.commands",
     "activeintent.sim.commands",
     "activeintent.web.commands",

@@ -54,7 +54,7 @@ def raw_get(url: str, path: str) -> tuple[int, str]:
 
 
 def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server):
-    srv = live_server("bayes-preference", rounds=2, seed=5)
+    srv = live_server("bayes-preference", rounds=2, seed=5, video_size=(128, 128))
     api = f"{srv.url}/api"
     created = httpx.post(f"{api}/sessions", json={"participant": "api-test"})
     assert created.status_code == 201
@@ -115,7 +115,7 @@ def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server)
 
 
 def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server):
-    srv = live_server("bayes-stop", rounds=1, seed=2)
+    srv = live_server("bayes-stop", rounds=1, seed=2, video_size=(128, 128))
     api = f"{srv.url}/api"
     sid = httpx.post(f"{api}/sessions").json()["id"]
     state = waiting_state(srv.url, sid, 1)
@@ -167,7 +167,7 @@ def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server):
 
 
 def test_unknown_sessions_path_traversal_and_isolation(live_server):
-    srv = live_server("bayes-preference", rounds=2, seed=1, max_sessions=2)
+    srv = live_server("bayes-preference", rounds=2, seed=1, max_sessions=2, video_size=(128, 128))
     api = f"{srv.url}/api"
     a = httpx.post(f"{api}/sessions").json()["id"]
     b = httpx.post(f"{api}/sessions").json()["id"]
@@ -186,7 +186,7 @@ def test_unknown_sessions_path_traversal_and_isolation(live_server):
     assert state_b["question"]["round"] == 1 and state_b["rounds_answered"] == 0
     assert snapshot(srv.session_dir(b)) == before_b
 
-    for sid in ("0123456789abcdef", "nope", "..", a.upper()):
+    for sid in ("0123456789abcdef", "nope", a.upper(), a + "0"):
         for method, path, body in [
             ("GET", f"/sessions/{sid}", None),
             ("POST", f"/sessions/{sid}/answer", {"kind": "preference", "round": 1, "choice": "A"}),
@@ -249,3 +249,17 @@ def test_openapi_describes_the_api(live_server):
     config = httpx.get(f"{srv.url}/api/config").json()
     assert config == {"method": "bayes-stop", "signal": "stop", "rounds": 1, "intention": None,
                       "show_estimate": True, "fps": 10}
+
+
+def test_stopping_the_server_cancels_sessions_in_progress(live_server):
+    srv = live_server("bayes-stop", rounds=2, seed=6, video_size=(128, 128))
+    sid = httpx.post(f"{srv.url}/api/sessions").json()["id"]
+    waiting_state(srv.url, sid, 1)
+    srv.manager.shutdown(timeout=60)  # what the app's lifespan does when uvicorn stops
+    session = srv.manager.get(sid)
+    assert not session.active and session.status == "cancelled" and "server stopped" in session.error
+    res = httpx.post(f"{srv.url}/api/sessions/{sid}/answer", json={"kind": "stop", "round": 1, "action": "looks_good"})
+    assert res.status_code == 409 and "cancelled" in res.json()["detail"]
+    log = [json.loads(x) for x in (srv.session_dir(sid) / "events.jsonl").read_text().splitlines()]
+    assert log[-1]["type"] == "session_cancelled"
+    assert read_rounds(srv.session_dir(sid) / "rounds.jsonl") == []

@@ -31,8 +31,13 @@ class RetrievalAnswer(BaseModel):
     retrieved: str = Field(min_length=8, max_length=300)
 
 
+def _escape(text: str) -> str:
+    # Only regex metacharacters: llama.cpp's pattern-to-grammar converter rejects "\ ".
+    return re.sub(r"([.^$*+?()\[\]{}|\\])", r"\\\1", text)
+
+
 def _alt(options: list[str]) -> str:
-    return "(" + "|".join(re.escape(o) for o in options) + ")"
+    return "(" + "|".join(_escape(o) for o in options) + ")"
 
 
 def goal_pattern(scene: Scene) -> str:

@@ -35,9 +35,7 @@ def serve(
 ) -> None:
     """Serve the study: participants give the preference or stop signal in the browser.
 
-    Every session is saved like a simulated run (summary.json, rounds.jsonl, videos) in
-    OUT/<session-id>/, plus events.jsonl with every UI event. The JSON API is described at
-    /openapi.json.
+    Each session is saved like a simulated run (summary.json, rounds.jsonl, videos) in OUT/<session-id>/, plus events.jsonl with every UI event. The JSON API is described at /openapi.json.
     """
     import uvicorn
     from rich.console import Console

@@ -126,10 +126,10 @@ def create_app(config: StudyConfig, builder: EpisodeBuilder | None = None) -> Fa
         for err in exc.errors():
             where = ".".join(str(p) for p in err.get("loc", ()) if p != "body")
             problems.append(f"{where}: {err.get('msg')}" if where else str(err.get("msg")))
-        return JSONResponse(
-            {"detail": "invalid request: " + "; ".join(problems), "errors": json.loads(json.dumps(exc.errors(), default=str))},
-            status_code=422,
-        )
+        # the offending input is not echoed back: it may not even be valid JSON (NaN)
+        errors = [{"loc": [str(p) for p in e.get("loc", ())], "msg": str(e.get("msg")), "type": str(e.get("type"))}
+                  for e in exc.errors()]
+        return JSONResponse({"detail": "invalid request: " + "; ".join(problems), "errors": errors}, status_code=422)
 
     def session_or_404(sid: str) -> WebSession:
         session = manager.get(sid)

@@ -49,6 +49,7 @@ class StudyConfig(BaseModel):
     out_dir: Path = Path("out/web")
     seed: int = Field(0, description="session n (0, 1, …) runs with seed + n unless it asks for one")
     fps: int = Field(10, ge=1, le=60, description="frames per second of the videos")
+    video_size: tuple[int, int] = Field((240, 240), description="width, height of the videos in pixels")
     answer_timeout: float | None = Field(1800.0, description="seconds to wait for one answer")
     max_sessions: int = Field(4, ge=1, description="sessions in progress at once")
 
@@ -196,7 +197,7 @@ class WebSession:
         from activeintent.sim.video import export_video
 
         fps = self.config.fps
-        export_video(traj, self.dir / f"{name}.webm", fps=fps)
+        export_video(traj, self.dir / f"{name}.webm", fps=fps, size=self.config.video_size)
         return VideoInfo(
             label=label,
             file=f"{name}.webm",

@@ -312,6 +312,10 @@ class Tower(Behaviour):
     def phrase(self, s: str) -> str:
         return f"{s} are stacked into one tower" + (" standing on the table" if self.table_only else "")
 
+    @property
+    def key(self) -> str:
+        return super().key + ("@table" if self.table_only else "")
+
     def moved_ok(self, fb: Facts, fa: Facts, group: Group, b: str) -> bool:
         # Building a tower only ever puts blocks on blocks.
         return fa.below[b] is not None or (len(group) == 1 and self.ok(fa, group, b))
@@ -408,7 +412,7 @@ class TwoTowers(Behaviour):
         half = (len(order) + 1) // 2
         steps: list[Skill] = []
         for part in (order[:half], order[half:]):
-            for lower, upper in zip(part, part[1:]):
+            for lower, upper in zip(part, part[1:], strict=False):
                 step = PutOn(block=upper, target=lower)
                 state, fail = apply_skill(state, step)
                 if fail is not None:
@@ -435,7 +439,7 @@ class Line(Behaviour):
         along = sorted(blocks, key=lambda b: f.xy[b][1 - self.axis])
         return all(
             f.xy[b][1 - self.axis] - f.xy[a][1 - self.axis] >= MIN_SPACING and f.next_to(a, b)
-            for a, b in zip(along, along[1:])
+            for a, b in zip(along, along[1:], strict=False)
         )
 
     def holds(self, f, group):

@@ -29,6 +29,7 @@ class Facts:
     near: frozenset[frozenset[str]]
     xy: dict[str, tuple[float, float]]
     cell: dict[str, str]
+    pos: dict[str, tuple[float, float, float]]
     memo: dict = field(default_factory=dict)  # per-state cache (groups of clauses)
 
     def next_to(self, a: str, b: str) -> bool:
@@ -69,6 +70,11 @@ def _key(state: WorldState) -> tuple:
     return tuple((n, round(p[0], 4), round(p[1], 4), round(p[2], 4)) for n, p in state.positions.items())
 
 
+def state_key(f: Facts) -> tuple:
+    """Identity of the state behind ``f`` (positions to 1 mm)."""
+    return tuple((n, round(p[0], 3), round(p[1], 3), round(p[2], 3)) for n, p in f.pos.items())
+
+
 _CACHE: OrderedDict[tuple, Facts] = OrderedDict()
 _CACHE_SIZE = 20000
 
@@ -94,6 +100,7 @@ def facts(state: WorldState) -> Facts:
         near=frozenset(frozenset(p) for p in rel.next_to),
         xy={n: (float(p[0]), float(p[1])) for n, p in state.positions.items()},
         cell=dict(rel.table_position),
+        pos=dict(state.positions),
     )
     _CACHE[key] = f
     if len(_CACHE) > _CACHE_SIZE:

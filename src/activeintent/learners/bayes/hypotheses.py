@@ -55,6 +55,15 @@ class Clause:
         skip = self.behaviour.excluded()
         return tuple(b for b in blocks if sel(b) and b != skip)
 
+    def judge_f(self, f: Facts) -> tuple[bool, float, int]:
+        """(holds, score, group size) on ``f``, memoised: many hypotheses share a clause."""
+        key = ("clause", self.selector, self.behaviour.key)
+        got = f.memo.get(key)
+        if got is None:
+            g = self.group_f(f)
+            got = f.memo[key] = (self.behaviour.holds(f, g), self.behaviour.score(f, g), len(g))
+        return got
+
     def group_f(self, f: Facts) -> tuple[str, ...]:
         key = (self.selector, self.behaviour.excluded())
         g = f.memo.get(key)
@@ -87,14 +96,14 @@ class Hypothesis(Intention):
     # -- judging states (Facts versions are used by the learner in bulk) --
 
     def holds_f(self, f: Facts) -> bool:
-        return all(c.behaviour.holds(f, c.group_f(f)) for c in self.clauses)
+        return all(c.judge_f(f)[0] for c in self.clauses)
 
     def score_f(self, f: Facts) -> float:
         total, n = 0.0, 0
         for c in self.clauses:
-            g = c.group_f(f)
-            total += c.behaviour.score(f, g) * len(g)
-            n += len(g)
+            _, score, size = c.judge_f(f)
+            total += score * size
+            n += size
         return total / n if n else 1.0
 
     def prefetch(self, states: list[Facts]) -> None:
@@ -277,8 +286,10 @@ def distinct_names(seed: int = 0, others: int = 6) -> list[str]:
     cached on disk (keyed by the source of the grammar and the world model): it takes seconds.
     """
     path = _cache_file(seed, others)
-    if path.exists():
-        return json.loads(path.read_text())
+    try:
+        return list(json.loads(path.read_text()))
+    except (OSError, ValueError):
+        pass  # not computed yet (or unreadable): compute it
     hyps = sorted(enumerate_hypotheses(), key=lambda h: h.bits)
     bank = _bank(seed, others)
     kept: dict[bytes, str] = {}
@@ -292,7 +303,9 @@ def distinct_names(seed: int = 0, others: int = 6) -> list[str]:
     names = list(kept.values())
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps(names))
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(names))
+        os.replace(tmp, path)  # atomic: parallel workers never read half a file
     except OSError:
         pass  # a read-only home only costs the recomputation
     return names

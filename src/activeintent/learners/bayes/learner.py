@@ -11,14 +11,19 @@ success under the belief; z is the description of the most probable hypothesis.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from pydantic import BaseModel, Field
 
 from activeintent.learners.base import Estimate, Learner, RoundRecord
 from activeintent.learners.bayes.facts import Facts, facts
-from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space, log_prior, random_scene
+from activeintent.learners.bayes.hypotheses import (
+    Hypothesis,
+    hypothesis_space,
+    log_prior,
+    random_scene,
+)
 from activeintent.learners.bayes.likelihood import (
     PreferenceModel,
     StopModel,
@@ -28,6 +33,7 @@ from activeintent.learners.bayes.likelihood import (
 )
 from activeintent.learners.bayes.query import (
     NEW_SCENE_LAPSE,
+    Outcome,
     Query,
     best_preference_query,
     best_stop_query,
@@ -41,13 +47,13 @@ from activeintent.learners.bayes.query import (
 from activeintent.llm.base import ChatModel
 from activeintent.signals import PreferenceFeedback, StopFeedback
 from activeintent.sim.trajectory import Trajectory
-from activeintent.world import Scene, Skill, WorldState, describe_plan
+from activeintent.world import Scene, WorldState, describe_plan, describe_skill, describe_state
 
 
 class BayesConfig(BaseModel):
     """Settings of the Bayesian learners (none is tuned to particular intentions)."""
 
-    n_scenes: int = Field(5, ge=1, description="candidate scenes scored per design_scene")
+    n_scenes: int = Field(4, ge=1, description="candidate scenes scored per design_scene")
     top_k: int = Field(16, ge=1, description="plans come from this many most probable hypotheses")
     explore: int = Field(6, ge=0, description="... plus this many random other hypotheses")
     max_plans: int = Field(36, ge=2, description="candidate plans per scene")
@@ -75,6 +81,7 @@ class Observation:
     reveal: np.ndarray | None = None
     start: np.ndarray | None = None
     duration: float = 0.0
+    texts: list[str] = field(default_factory=list)  # what was shown, in words (for proposals)
     log_evidence: float = 0.0  # log Σ_z w_z P(h | z) when it was observed (the normaliser)
 
 
@@ -255,11 +262,11 @@ class BayesLearner(Learner):
         if w.sum() <= 0:
             w = self.weights
         w = w / w.sum()
-        plans = [[]] + candidate_plans(
+        outs = [predict(state, [])] + candidate_plans(
             self.hyps, w, state, self.rng, top_k=2 * self.config.top_k, explore=0,
             prefixes=False, limit=3 * self.config.max_plans,
         )
-        outs = [predict(state, p) for p in plans]
+        plans = [o.plan for o in outs]
         for h in self.hyps:
             h.prefetch([o.final for o in outs])
         success = np.array([float(w @ judge(self.hyps, o.final)[0]) for o in outs])
@@ -282,7 +289,7 @@ class BayesLearner(Learner):
     def _observation(self, scene: Scene, fb, trajectories: list[Trajectory]) -> Observation:
         raise NotImplementedError
 
-    def _candidates(self, state: WorldState, prefixes: bool) -> list[list[Skill]]:
+    def _candidates(self, state: WorldState, prefixes: bool) -> list[Outcome]:
         return candidate_plans(
             self.hyps, self.weights, state, self.rng, top_k=self.config.top_k,
             explore=self.config.explore, prefixes=prefixes, limit=self.config.max_plans,
@@ -308,8 +315,6 @@ class BayesPreferenceLearner(BayesLearner):
 
     def _select(self, state: WorldState) -> Query | None:
         plans = self._candidates(state, prefixes=True)
-        for h in self.hyps:
-            h.prefetch([predict(state, p).final for p in plans])
         return best_preference_query(self.hyps, self.weights, state, plans, self.config.preference)
 
     def _observation(self, scene, fb, trajectories):
@@ -323,7 +328,8 @@ class BayesPreferenceLearner(BayesLearner):
         common = [b for b in finals[0].blocks if b in finals[1].positions]
         pos = np.stack([[s.pos(b) for b in common] for s in finals])
         sim = float(similarity(pos)[0, 1]) if common else 0.0
-        return Observation("preference", scene, fb, [facts(s) for s in finals], similarity=sim)
+        texts = [f"{k}: {describe_state(s)}" for k, s in zip("AB", finals, strict=True)]
+        return Observation("preference", scene, fb, [facts(s) for s in finals], similarity=sim, texts=texts)
 
 
 class BayesStopLearner(BayesLearner):
@@ -335,8 +341,6 @@ class BayesStopLearner(BayesLearner):
 
     def _select(self, state: WorldState) -> Query | None:
         plans = self._candidates(state, prefixes=False)
-        for h in self.hyps:
-            h.prefetch([f for p in plans for st in predict(state, p).steps for f in st[:2]])
         return best_stop_query(self.hyps, self.weights, state, plans, self.config.stop)
 
     def _observation(self, scene, fb, trajectories):
@@ -359,4 +363,5 @@ class BayesStopLearner(BayesLearner):
             reveal=np.array([traj.time_of(s.reveal_tick) for s in traj.steps]),
             start=np.array([traj.time_of(s.start_tick) for s in traj.steps]),
             duration=traj.duration,
+            texts=[f"step {s.index + 1}: {describe_skill(s.skill)}" for s in traj.steps],
         )

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from activeintent.learners.bayes.facts import Facts, facts
+from activeintent.learners.bayes.facts import Facts, facts, state_key
 from activeintent.learners.bayes.hypotheses import Hypothesis
 from activeintent.learners.bayes.likelihood import (
     PreferenceModel,
@@ -68,8 +68,12 @@ class Outcome:
 
     plan: list[Skill]
     final: Facts
-    positions: np.ndarray  # block positions at the end, [n_blocks, 3]
     steps: list[tuple[Facts, Facts, str, bool]] = field(default_factory=list)
+
+    @property
+    def positions(self) -> np.ndarray:
+        """Block positions at the end, [n_blocks, 3]."""
+        return np.array([self.final.pos[b] for b in self.final.blocks])
 
 
 def predict(state: WorldState, plan: list[Skill]) -> Outcome:
@@ -78,14 +82,7 @@ def predict(state: WorldState, plan: list[Skill]) -> Outcome:
     steps = [
         (facts(seq[i]), facts(seq[i + 1]), plan[i].block, fails[i] is None) for i in range(len(plan))
     ]
-    end = seq[-1]
-    return Outcome(plan, facts(end), np.array([end.pos(b) for b in end.blocks]), steps)
-
-
-def _plan_key(state: WorldState, plan: list[Skill]) -> tuple:
-    end, _ = apply_plan(state, plan)
-    final = end[-1] if end else state
-    return tuple((n, round(p[0], 3), round(p[1], 3), round(p[2], 3)) for n, p in final.positions.items())
+    return Outcome(plan, facts(seq[-1]), steps)
 
 
 def candidate_plans(
@@ -97,7 +94,7 @@ def candidate_plans(
     explore: int = 8,
     prefixes: bool = True,
     limit: int = 48,
-) -> list[list[Skill]]:
+) -> list[Outcome]:
     """Plans of the most probable hypotheses feasible in the scene (their alternative plans
     and partial plans too) plus those of a few random others, distinct by predicted outcome."""
     scene = state.scene
@@ -107,21 +104,22 @@ def candidate_plans(
     rest = feasible[top_k:]
     if rest and explore:
         chosen += [rest[j] for j in rng.choice(len(rest), size=min(explore, len(rest)), replace=False)]
-    plans: list[list[Skill]] = []
-    seen: set[tuple] = set()
+    outs: list[Outcome] = []
+    seen: set[tuple] = {state_key(facts(state))}  # doing nothing is never worth showing
     for i in chosen:
         for p in hyps[i].plans(state):
-            options = [p[:k] for k in range(1, len(p))] + [p] if prefixes else [p]
-            for q in options[::-1]:
-                if not q:
-                    continue
-                key = _plan_key(state, q)
+            full = predict(state, p)
+            options = [full]
+            if prefixes:
+                options += [Outcome(p[:k], full.steps[k - 1][1], full.steps[:k]) for k in range(len(p) - 1, 0, -1)]
+            for o in options:
+                key = state_key(o.final)
                 if key not in seen:
                     seen.add(key)
-                    plans.append(q)
-        if len(plans) >= limit:
+                    outs.append(o)
+        if len(outs) >= limit:
             break
-    return plans[:limit]
+    return outs[:limit]
 
 
 def _entropy(p: np.ndarray, axis: int = -1) -> np.ndarray:
@@ -158,13 +156,15 @@ def best_preference_query(
     hyps: tuple[Hypothesis, ...],
     weights: np.ndarray,
     state: WorldState,
-    plans: list[list[Skill]],
+    outs: list[Outcome],
     model: PreferenceModel,
 ) -> Query | None:
     """The pair of plans with the largest EIG (vectorised over all pairs and hypotheses)."""
-    if len(plans) < 2:
+    if len(outs) < 2:
         return None
-    outs = [predict(state, p) for p in plans]
+    plans = [o.plan for o in outs]
+    for h in hyps:
+        h.prefetch([o.final for o in outs])
     sat = np.stack([judge(hyps, o.final)[0] for o in outs])  # [P, H]
     score = np.stack([judge(hyps, o.final)[1] for o in outs])
     u = utility(score, sat)
@@ -174,7 +174,7 @@ def best_preference_query(
     feas = np.array([h.feasible(state.scene) for h in hyps])
     gains = eig(weights, with_new_scene(probs, feas))
     # Among (near-)equal gains prefer short plans: they are cheaper to show.
-    cost = np.array([len(plans[a]) + len(plans[b]) for a, b in zip(i, j)])
+    cost = np.array([len(plans[a]) + len(plans[b]) for a, b in zip(i, j, strict=False)])
     best = int(np.argmax(gains - 1e-4 * cost))
     return Query([plans[i[best]], plans[j[best]]], float(gains[best]))
 
@@ -183,20 +183,21 @@ def best_stop_query(
     hyps: tuple[Hypothesis, ...],
     weights: np.ndarray,
     state: WorldState,
-    plans: list[list[Skill]],
+    outs: list[Outcome],
     model: StopModel,
 ) -> Query | None:
     """The plan with the largest EIG over the discretised stop outcome."""
-    if not plans:
+    if not outs:
         return None
+    for h in hyps:
+        h.prefetch([f for o in outs for st in o.steps for f in st[:2]])
     feas = np.array([h.feasible(state.scene) for h in hyps])
     gains = []
-    for p in plans:
-        out = predict(state, p)
-        probs = stop_outcome_probs(first_away(hyps, out.steps), len(p), model)
-        gains.append(float(eig(weights, with_new_scene(probs, feas))) - 1e-4 * len(p))
+    for o in outs:
+        probs = stop_outcome_probs(first_away(hyps, o.steps), len(o.plan), model)
+        gains.append(float(eig(weights, with_new_scene(probs, feas))) - 1e-4 * len(o.plan))
     best = int(np.argmax(gains))
-    return Query([plans[best]], gains[best])
+    return Query([outs[best].plan], gains[best])
 
 
 def scene_state(scene: Scene, seed: int) -> WorldState:

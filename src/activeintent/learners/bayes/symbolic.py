@@ -108,3 +108,125 @@ def run_symbolic_episode(
         "preference": est.preference,
         "select_s": select_s,
     }
+
+
+def make_learner(signal: str, seed: int, config=None):
+    from activeintent.learners.bayes.learner import BayesPreferenceLearner, BayesStopLearner
+
+    if signal not in ("preference", "stop"):
+        raise ValueError(f"unknown signal {signal!r}; valid: preference, stop")
+    cls = BayesPreferenceLearner if signal == "preference" else BayesStopLearner
+    return cls(rng=np.random.default_rng(seed), config=config)
+
+
+def grammar_only_intentions(n: int, seed: int = 0) -> list[Intention]:
+    """``n`` hypotheses of H (seeded draw) that agree with none of the named intentions."""
+    from activeintent.intentions.registry import all_intentions
+    from activeintent.learners.bayes.hypotheses import hypothesis_space
+
+    hyps = list(hypothesis_space())
+    named = [matching_hypothesis(it, hyps) for it in all_intentions()]
+    pool = [h for h in hyps if h not in named]
+    rng = np.random.default_rng(seed)
+    return [pool[i] for i in rng.choice(len(pool), size=min(n, len(pool)), replace=False)]
+
+
+def agreement_states(
+    intention: Intention, hyps, n_scenes: int = 6, seed: int = 0, others: int | None = None
+) -> list[WorldState]:
+    """States to compare an intention with hypotheses: initial layouts of scenes feasible for
+    it, its own plan's outcome, and the outcomes of the plans of the hypotheses feasible there
+    (of ``others`` random ones of them, if given)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(n_scenes):
+        scene = intention.sample_scene(rng)
+        state = WorldState(positions=layout(scene, seed * 100 + i))
+        out.append(state)
+        feasible = [h for h in hyps if h.feasible(scene)]
+        if others is not None and len(feasible) > others:
+            feasible = [feasible[j] for j in rng.choice(len(feasible), size=others, replace=False)]
+        plans = [intention.plan(state)] + [h.plan(state) for h in feasible]
+        for p in plans:
+            if p:
+                states, _ = apply_plan(state, p)
+                out.append(states[-1])
+    return out
+
+
+def matching_hypothesis(intention: Intention, hyps, n_scenes: int = 8, others: int | None = 40):
+    """The first hypothesis whose ``satisfied`` equals the intention's on every agreement state."""
+    states = agreement_states(intention, hyps, n_scenes, others=others)
+    truth = [intention.satisfied(s) for s in states]
+    for h in hyps:
+        if all(h.satisfied(s) == t for s, t in zip(states, truth, strict=True)):
+            return h
+    return None
+
+
+def benchmark(
+    signal: str,
+    intentions: list[Intention],
+    seeds: list[int],
+    user_config=None,
+    rounds: int = 5,
+    test_scenes: int = 1,
+    progress=None,
+) -> dict:
+    """Success and signals over intentions × seeds with simulated users (no physics)."""
+    from activeintent.users.simulated import make_user
+
+    rows = []
+    for it in intentions:
+        for seed in seeds:
+            learner = make_learner(signal, seed)
+            user = make_user(signal, it, user_config, seed=seed + 1000)
+            r = run_symbolic_episode(learner, it, user, rounds=rounds, seed=seed, test_scenes=test_scenes)
+            rows.append({"intention": it.name, "seed": seed, **r})
+            if progress:
+                progress()
+    times = [t for r in rows for t in r["select_s"]]
+    per: dict[str, list[float]] = {}
+    for r in rows:
+        per.setdefault(r["intention"], []).append(r["success"])
+    return {
+        "signal": signal,
+        "episodes": len(rows),
+        "success": float(np.mean([r["success"] for r in rows])) if rows else 0.0,
+        "per_intention": {k: float(np.mean(v)) for k, v in per.items()},
+        "mean_signals": float(np.mean([r["signals"] for r in rows])) if rows else 0.0,
+        "select_s_mean": float(np.mean(times)) if times else 0.0,
+        "select_s_max": float(np.max(times)) if times else 0.0,
+        "rows": [{k: v for k, v in r.items() if k != "select_s"} for r in rows],
+    }
+
+
+def selection_benchmark(queries: int = 4, seed: int = 0) -> dict:
+    """Per-query selection time (design_scene + estimate) for both learners, mid-episode:
+    the belief is updated by an exact user of a paper intention between queries."""
+    from activeintent.intentions.registry import get_intention
+    from activeintent.users.simulated import make_user
+
+    out = {}
+    for signal in ("preference", "stop"):
+        learner = make_learner(signal, seed)
+        intention = get_intention("color-match")
+        user = make_user(signal, intention, seed=seed)
+        rng = np.random.default_rng(seed)
+        times = []
+        for r in range(queries):
+            t0 = time.perf_counter()
+            scene = learner.design_scene(rng)
+            state = WorldState(positions=layout(scene, int(rng.integers(2**31))))
+            est = learner.estimate(scene, state)
+            times.append(time.perf_counter() - t0)
+            trajs = [symbolic_trajectory(scene, state, p) for p in est.plans or []]
+            fb = user.respond(scene, trajs)
+            learner.observe(RoundRecord(index=r, scene=scene, estimate=est, plans=est.plans or [], feedback=fb), trajs)
+        out[signal] = {
+            "queries": queries,
+            "mean_s": float(np.mean(times)),
+            "max_s": float(np.max(times)),
+            "per_query_s": [round(t, 3) for t in times],
+        }
+    return out
