@@ -63,7 +63,7 @@ def run(
         table.add_column(col, style=style, overflow="fold")
     progress = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
                         TimeElapsedColumn(), console=console)
-    task = progress.add_task("rounds", total=rounds)
+    task = progress.add_task("signals", total=rounds)
 
     def on_round(log) -> None:
         h = log.feedback
@@ -71,7 +71,8 @@ def run(
             "new scene" if h.get("new_scene") else "no stop" if h.get("stop_time") is None
             else f"stop at {h['stop_time']:.2f} s (step {(h.get('step_index') or 0) + 1})")
         table.add_row(str(log.round), log.preference, "\n".join(log.goals), signal, log.retrieved or "")
-        progress.update(task, advance=1)
+        if signal != "new scene" and signal != "new_scene":
+            progress.update(task, advance=1)  # the bar counts signals; new-scene answers are free
 
     try:
         with console.status("loading models and simulator…"):

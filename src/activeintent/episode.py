@@ -36,7 +36,7 @@ class EpisodeConfig(BaseModel):
     seed: int = 0
     test_scenes: int = Field(1, ge=1, le=50, description="fresh scenes the final answer is tested on")
     max_new_scenes: int = Field(3, ge=0, description="'new scene' answers allowed on top of K")
-    max_goal_retries: int = Field(2, ge=0, description="re-asks when y cannot be turned into motion")
+    max_goal_retries: int = Field(1, ge=0, description="re-asks when y cannot be turned into motion")
     video_fps: int = 10
     save_videos: bool = True
     track_progress: bool = Field(False, description="after each round, test the current estimate (symbolically)")
@@ -222,15 +222,17 @@ class Episode:
         shown: set[frozenset[str]] = set()
         signals = attempts = 0
         error = None
+        after_new_scene = False
         # The test scenes are fixed up front (seeded) so per-round progress is measured on them.
         test_scenes = self._test_scenes(set())
         try:
             while signals < cfg.rounds and attempts < cfg.rounds + cfg.max_new_scenes:
-                log = self._round(len(logs), scene_rng, layout_rng, learner_rng, test_scenes[0])
+                log = self._round(len(logs), scene_rng, layout_rng, learner_rng, test_scenes[0], after_new_scene)
                 attempts += 1
                 logs.append(log)
                 shown.add(frozenset(log.scene))
-                if not log.feedback.get("new_scene") and log.feedback.get("choice") != "new_scene":
+                after_new_scene = bool(log.feedback.get("new_scene")) or log.feedback.get("choice") == "new_scene"
+                if not after_new_scene:
                     signals += 1
                 if log.done:
                     break
@@ -273,13 +275,19 @@ class Episode:
             (self.out / "summary.json").write_text(result.model_dump_json(indent=2))
         return result
 
-    def _round(self, index: int, scene_rng, layout_rng, learner_rng, test_scene: Scene) -> RoundLog:
+    def _round(self, index: int, scene_rng, layout_rng, learner_rng, test_scene: Scene, after_new_scene: bool) -> RoundLog:
         t0 = dict(self.clock.split)
-        scene = self.clock.timed("model_s", self.learner.design_scene, learner_rng)
-        source = "learner"
+        scene, source = None, "learner"
+        if after_new_scene:
+            source = "sampled (the user asked for a new scene)"
+        else:
+            scene = self.clock.timed("model_s", self.learner.design_scene, learner_rng)
+            if scene is None:
+                source = "sampled (the learner designs no scenes, or its choice was unusable)"
         if scene is None:
-            scene = sample_scene(scene_rng)
-            source = "sampled (the learner designs no scenes, or its choice was unusable)"
+            # Two or three blocks and two bowls, bowls matching blocks' colours where possible:
+            # such scenes can show most intentions, without knowing which one is hidden.
+            scene = sample_scene(scene_rng, n_blocks=(2, 3), n_bowls=2, matching=True)
         layout_seed = int(layout_rng.integers(2**31))
         state = self.clock.timed("sim_s", self.env.reset, scene, layout_seed)
         est, plans, failures = self._estimate_and_ground(scene, state, final=False)

@@ -85,8 +85,8 @@ class _ModelLearner(Learner):
         try:
             choice = self._ask("x_scene_design", self.llm, [Message(role="user", content=text)], scene_schema())
             scene = Scene(objects=choice.objects)
-            if len(scene.blocks) < 2:
-                raise SceneError(f"the scene needs at least 2 blocks, got {scene.blocks}")
+            if len(scene.blocks) < 2 or not scene.bowls:
+                raise SceneError(f"a scene needs at least 2 blocks and a bowl, got {scene}")
             layout(scene, 0)
         except (ModelError, ValidationError, SceneError) as err:
             self.transcript.append({"template": "x_scene_design", "unusable": str(err).splitlines()[0]})

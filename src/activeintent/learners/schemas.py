@@ -21,7 +21,7 @@ MAX_STEPS = 5
 class IntentionAnswer(BaseModel):
     """z: the estimated user intention (eq. 1 / eq. 5)."""
 
-    preference: str = Field(min_length=8, max_length=200, description="one sentence: the user's preference z")
+    preference: str = Field(min_length=8, max_length=160, description="one sentence: the user's preference z")
     done: bool = Field(description="true only when sure of the preference")
 
 
@@ -49,7 +49,8 @@ def goal_pattern(scene: Scene) -> str:
     if scene.bowls:
         where.insert(0, f"in the {_alt(scene.bowls)}")
     step = f"put the {blocks} ({'|'.join(where)})"
-    return f"^{step}(, then {step}){{0,{MAX_STEPS - 1}}}$"
+    extra = max(0, min(MAX_STEPS, len(scene.blocks)) - 1)  # no more steps than blocks
+    return f"^{step}(, then {step}){{0,{extra}}}$"
 
 
 def goals_schema(scene: Scene, n_goals: int) -> type[BaseModel]:
