@@ -32,9 +32,10 @@ def make_learner(
     (when given) only to propose open-ended hypotheses."""
     check_method(method)
     if method in BAYES_METHODS:
-        from activeintent.learners.bayes.learner import make_bayes_learner
+        from activeintent.learners.bayes.learner import BayesPreferenceLearner, BayesStopLearner
 
-        return make_bayes_learner(method, seed=seed, llm=llm)
+        cls = BayesPreferenceLearner if method == "bayes-preference" else BayesStopLearner
+        return cls(rng=seed, llm=llm)
     from activeintent.learners.paper import (
         MllmLearner,
         MllmLlmLearner,

@@ -394,7 +394,7 @@ class TwoTowers(Behaviour):
     variants = 2
 
     def phrase(self, s: str) -> str:
-        return f"{s} are stacked into two towers on the table"
+        return f"{s} are stacked into two towers"
 
     def holds(self, f, group):
         towers = _towers(f, group)
