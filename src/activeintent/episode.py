@@ -220,19 +220,20 @@ class Episode:
         learner_rng = np.random.default_rng(self.seeds.learner)
         logs: list[RoundLog] = []
         shown: set[frozenset[str]] = set()
-        signals = attempts = 0
+        signals = new_scenes = 0
         error = None
         after_new_scene = False
         # The test scenes are fixed up front (seeded) so per-round progress is measured on them.
         test_scenes = self._test_scenes(set())
         try:
-            while signals < cfg.rounds and attempts < cfg.rounds + cfg.max_new_scenes:
+            while signals < cfg.rounds:
                 log = self._round(len(logs), scene_rng, layout_rng, learner_rng, test_scenes[0], after_new_scene)
-                attempts += 1
                 logs.append(log)
                 shown.add(frozenset(log.scene))
                 after_new_scene = bool(log.feedback.get("new_scene")) or log.feedback.get("choice") == "new_scene"
-                if not after_new_scene:
+                new_scenes += after_new_scene
+                # New-scene answers are free up to max_new_scenes; past that they use the budget.
+                if not after_new_scene or new_scenes > cfg.max_new_scenes:
                     signals += 1
                 if log.done:
                     break

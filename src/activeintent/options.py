@@ -8,7 +8,7 @@ import typer
 
 from activeintent.runner import UserOptions
 
-Llm = Annotated[str, typer.Option("--llm", help="LLM spec: embedded | gguf:/path.gguf | openai:<model>")]
+Llm = Annotated[str, typer.Option("--llm", help="LLM spec: embedded | gguf:/path.gguf | openai:<model> | none (Bayesian methods only)")]
 Vlm = Annotated[str | None, typer.Option("--vlm", help="Multimodal model spec for the retriever (default: the LLM)")]
 BaseUrl = Annotated[str | None, typer.Option("--base-url", envvar="OPENAI_BASE_URL", help="OpenAI-compatible endpoint")]
 Cache = Annotated[str | None, typer.Option("--cache", help="Response cache file (SQLite); default ~/.cache/activeintent")]

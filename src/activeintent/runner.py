@@ -59,12 +59,14 @@ class Models:
     def _load(self, spec: str):
         from activeintent.llm.registry import load_model
 
+        if spec == "none":
+            return None
         o = self.options
         return load_model(spec, base_url=o.base_url, cache_path=o.cache, cache_mode=o.cache_mode)
 
     @property
     def llm(self):
-        if self._llm is None:
+        if self._llm is None and self.options.llm != "none":
             self._llm = self._load(self.options.llm)
         return self._llm
 
@@ -99,7 +101,7 @@ def build_episode(
     (unknown method, intention, executor, model spec) are raised here, before any work."""
     from activeintent.act.base import make_executor
     from activeintent.intentions.registry import resolve_intention
-    from activeintent.learners.registry import BAYES_METHODS, SIGNAL, check_method, make_learner
+    from activeintent.learners.registry import SIGNAL, check_method, make_learner
     from activeintent.sim.env import TabletopEnv
     from activeintent.users.simulated import UserConfig, make_user
 
@@ -107,12 +109,12 @@ def build_episode(
     intention = resolve_intention(options.intention or (None if options.intention_file else DEFAULT_INTENTION),
                                   options.intention_file)
     models = Models(options)
-    needs_model = options.method not in BAYES_METHODS
-    llm = models.llm if needs_model else None
+    # Bayesian methods need no model; given one, it proposes open-ended hypotheses.
+    llm = models.llm
     learner = make_learner(options.method, llm=llm, vlm=models.vlm, retriever=options.retriever,
                            seed=EpisodeSeeds.from_seed(options.seed).learner,
                            design_scenes=options.design_scenes, epsilon=options.epsilon)
-    executor = make_executor(options.executor, model=llm if needs_model else None)
+    executor = make_executor(options.executor, model=llm)
     seeds = EpisodeSeeds.from_seed(options.seed)
     if user is None:
         u = options.user

@@ -18,7 +18,7 @@ from typing import Any
 from pydantic import BaseModel, Field
 
 from activeintent.llm.backend import Backend, ChatRequest, Completion
-from activeintent.llm.base import Message, ModelError, ModelUnavailableError
+from activeintent.llm.base import Message, ModelError, ModelUnavailableError, StructuredOutputError
 
 # llama.cpp's OpenMP workers spin while waiting by default; on a busy 2-core machine (physics,
 # other processes) that makes generation several times slower. Must be set before the library
@@ -102,12 +102,29 @@ _LOOSE_CHAR = r'char ::= [^"\\] |'
 _JSON_CHAR = r'char ::= [^"\\\x7F\x00-\x1F] |'
 
 
+# llama.cpp unrolls a bounded repetition into nested rules and refuses large bounds; longer
+# limits are left to pydantic validation (and the repair round) instead of the grammar.
+GRAMMAR_MAX_REPEAT = 200
+
+
+def _loosen(node: object) -> object:
+    if isinstance(node, dict):
+        out = {k: _loosen(v) for k, v in node.items()}
+        for key in ("maxLength", "maxItems"):
+            if isinstance(out.get(key), int) and out[key] > GRAMMAR_MAX_REPEAT:
+                del out[key]
+        return out
+    if isinstance(node, list):
+        return [_loosen(v) for v in node]
+    return node
+
+
 @lru_cache(maxsize=64)
 def _grammar_text(schema_json: str) -> str:
     """GBNF for a JSON schema (property order kept: the model writes fields in that order)."""
     from llama_cpp.llama_grammar import json_schema_to_gbnf
 
-    gbnf = json_schema_to_gbnf(schema_json)
+    gbnf = json_schema_to_gbnf(json.dumps(_loosen(json.loads(schema_json))))
     # llama-cpp-python's string character rule admits raw control characters (newlines),
     # which JSON forbids inside strings; use JSON's own rule.
     return "\n".join(
@@ -169,6 +186,20 @@ class EmbeddedBackend(Backend):
         )
         self._lock = _CALL_LOCKS[id(self.llama)]
 
+    def _check_grammar(self, grammar) -> None:
+        """llama.cpp returns no sampler for a grammar it cannot parse, and using none crashes
+        the process; try it first and raise a ModelError instead."""
+        import llama_cpp
+
+        vocab = llama_cpp.llama_model_get_vocab(self.llama.model)
+        sampler = llama_cpp.llama_sampler_init_grammar(vocab, grammar._grammar.encode(), grammar._root.encode())
+        if not sampler:
+            raise StructuredOutputError(
+                f"embedded {self.model_name}: llama.cpp cannot compile a grammar for this schema "
+                "(too many bounded repetitions or an unsupported pattern)"
+            )
+        llama_cpp.llama_sampler_free(sampler)
+
     def _has_turn_markers(self) -> bool:
         return all(
             len(self.llama.tokenize(marker, add_bos=False, special=True)) == 1
@@ -182,6 +213,7 @@ class EmbeddedBackend(Backend):
         if request.json_schema is not None:
             schema_json = json.dumps(request.json_schema)
             grammar = LlamaGrammar.from_string(_grammar_text(schema_json), verbose=False)
+            self._check_grammar(grammar)
         with self._lock:
             if not self.config.reuse_prefix:
                 # Evaluate every prompt from scratch: an answer is a function of its request

@@ -119,6 +119,8 @@ class BayesLearner(Learner):
         self.collapses = 0
         self.proposal_calls = 0
         self.log: list[dict] = []  # per round: top hypotheses, gain, collapse, proposals
+        self.prior_entropy = self.entropy_bits()
+        self._drained = 0
 
     # ---- belief ----
 
@@ -129,6 +131,25 @@ class BayesLearner(Learner):
     def top(self, n: int = 1) -> list[tuple[Hypothesis, float]]:
         w = self.weights
         return [(self.hyps[i], float(w[i])) for i in np.argsort(-w, kind="stable")[:n]]
+
+    def stats(self) -> dict:
+        """Information gained: prior minus posterior entropy of the belief, per signal given."""
+        signals = sum(1 for entry in self.log if not entry.get("new_scene"))
+        gained = self.prior_entropy - self.entropy_bits()
+        return {
+            "hypotheses": len(self.hyps),
+            "prior_entropy_bits": round(self.prior_entropy, 3),
+            "posterior_entropy_bits": round(self.entropy_bits(), 3),
+            "bits_per_signal": round(gained / signals, 3) if signals else None,
+            "top": [(h.name, round(p, 4)) for h, p in self.top(3)],
+            "collapses": self.collapses,
+        }
+
+    def drain_transcript(self) -> list[dict]:
+        """The belief after each update (top hypotheses, entropy), for rounds.jsonl."""
+        out = [dict(entry, template="belief") for entry in self.log[self._drained:]]
+        self._drained = len(self.log)
+        return out
 
     def entropy_bits(self) -> float:
         w = self.weights
@@ -245,6 +266,8 @@ class BayesLearner(Learner):
         self.log.append(
             {
                 "round": record.index,
+                "new_scene": (isinstance(fb, PreferenceFeedback) and fb.choice == "new_scene")
+                or bool(getattr(fb, "new_scene", False)),
                 "evidence": evidence,
                 "collapsed": collapsed,
                 "proposed": proposed,

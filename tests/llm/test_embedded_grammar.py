@@ -1,0 +1,38 @@
+"""Schemas beyond what llama.cpp's grammar can unroll neither crash the process nor fail."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from pydantic import BaseModel, Field
+
+from activeintent.llm.base import Message, StructuredOutputError
+from activeintent.llm.embedded import GRAMMAR_MAX_REPEAT, _loosen
+
+
+class LongText(BaseModel):
+    code: str = Field(max_length=3000)
+    items: list[int] = Field(default_factory=list, max_length=5)
+
+
+def test_long_bounds_are_left_to_validation():
+    schema = _loosen(LongText.model_json_schema())
+    assert "maxLength" not in json.dumps(schema["properties"]["code"])
+    assert schema["properties"]["items"]["maxItems"] == 5 <= GRAMMAR_MAX_REPEAT
+
+
+@pytest.mark.slow
+def test_embedded_answers_a_long_bounded_schema_and_refuses_bad_grammar():
+    from llama_cpp import LlamaGrammar
+    from llama_cpp.llama_grammar import json_schema_to_gbnf
+
+    from activeintent.llm.registry import load_model
+
+    model = load_model("embedded", cache_mode="off")
+    answer = model.structured([Message(role="user", content="Write a tiny Python expression.")], LongText, max_tokens=40)
+    assert isinstance(answer, LongText)
+    unrolled = json_schema_to_gbnf(json.dumps(LongText.model_json_schema()))  # maxLength 3000 kept
+    bad = LlamaGrammar.from_string(unrolled, verbose=False)
+    with pytest.raises(StructuredOutputError):
+        model.backend._check_grammar(bad)
