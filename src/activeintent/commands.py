@@ -38,11 +38,10 @@ def run(
     out: Annotated[Path | None, typer.Option("--out", help="Output folder (default runs/<method>-<intention>-seed<S>)")] = None,
 ) -> None:
     """Run one episode: the learner asks, a simulated user with a hidden intention answers."""
-    from rich.console import Console
+    from rich.console import Console, Group
     from rich.live import Live
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
-    from rich.console import Group
 
     from activeintent.llm.base import ModelError
     from activeintent.runner import RunOptions, build_episode

@@ -179,7 +179,7 @@ class Episode:
                 plan, failure = self._plan(goal, state)
                 plans.append(plan)
                 failures.append(failure)
-            bad = [(g, f) for g, f in zip(est.goals, failures) if f]
+            bad = [(g, f) for g, f in zip(est.goals, failures, strict=False) if f]
             if not bad or attempt == self.config.max_goal_retries:
                 return est, plans, failures
             for goal, failure in bad:

@@ -22,7 +22,7 @@ INTENTIONS = ["stack", "color-match"]
 
 def tiny(jobs: int = 1) -> BenchOptions:
     return BenchOptions(methods=METHODS, intentions=INTENTIONS, trials=1, seed=5, jobs=jobs,
-                        run=RunOptions(rounds=2, save_videos=False))
+                        run=RunOptions(rounds=2, save_videos=False, llm="none"))
 
 
 def test_wilson_interval_matches_known_values():
@@ -71,7 +71,7 @@ def test_resume_skips_finished_and_drops_a_torn_line(tmp_path):
 def test_killed_bench_resumes_without_duplicates(tmp_path):
     out = tmp_path / "killed"
     cmd = [sys.executable, "-m", "activeintent.cli", "bench", "--methods", ",".join(METHODS), "--intentions",
-           "stack,color-match,align", "--trials", "2", "--rounds", "2", "--seed", "9", "--out", str(out)]
+           "stack,color-match,align", "--trials", "2", "--rounds", "2", "--seed", "9", "--llm", "none", "--out", str(out)]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     results = out / "results.jsonl"
     deadline = time.monotonic() + 600

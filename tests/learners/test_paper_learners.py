@@ -5,17 +5,22 @@ from __future__ import annotations
 import re
 
 import pytest
-from helpers import kinematic_trajectory
 
 from activeintent.learners import prompts
 from activeintent.learners.base import Estimate, RoundRecord
-from activeintent.learners.paper import MllmLearner, MllmLlmLearner, PaperLearnerConfig, PreferenceLearner
+from activeintent.learners.paper import (
+    MllmLearner,
+    MllmLlmLearner,
+    PaperLearnerConfig,
+    PreferenceLearner,
+)
 from activeintent.learners.retrievers import as_text, prompt_h
 from activeintent.learners.schemas import goal_pattern, goals_schema
 from activeintent.llm.base import ImagePart
 from activeintent.llm.scripted import ScriptedModel
 from activeintent.signals import PreferenceFeedback, StopFeedback
 from activeintent.world import PutIn, PutNextTo, PutOn, Scene, WorldState, describe_plan, layout
+from helpers import kinematic_trajectory
 
 SCENE = Scene(objects=["red block", "blue block", "red bowl", "green bowl"])
 PLAN = [PutIn(block="red block", bowl="green bowl"), PutOn(block="blue block", target="red block")]
@@ -28,7 +33,7 @@ def responder(messages, schema):
     if title == "GoalsAnswer":
         fields = list(schema["properties"])
         goals = ["put the red block in the red bowl", "put the red block in the green bowl, then put the blue block on the red block"]
-        return dict(zip(fields, goals))
+        return dict(zip(fields, goals, strict=False))
     if title == "RetrievalAnswer":
         return {"retrieved": "The robot put the red block into the green bowl, which the user did not want."}
     if title == "SceneChoice":

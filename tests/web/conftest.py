@@ -15,7 +15,7 @@ import pytest
 import uvicorn
 
 from activeintent.learners.registry import SIGNAL
-from activeintent.web.server import create_app
+from activeintent.web.server import create_app, runner_builder
 from activeintent.web.session import SessionManager, StudyConfig
 
 CHROMIUM = os.environ.get("ACTIVEINTENT_CHROMIUM", "/usr/bin/chromium")
@@ -56,7 +56,7 @@ def live_server(tmp_path) -> Iterator:
     def start(method: str, rounds: int = 2, **study) -> LiveServer:
         out = tmp_path / f"out-{len(servers)}"
         config = StudyConfig(method=method, signal=SIGNAL[method], rounds=rounds, out_dir=out, **study)
-        app = create_app(config)
+        app = create_app(config, runner_builder(config, llm="none"))  # Bayesian methods, no model
         port = _free_port()
         server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
         thread = threading.Thread(target=server.run, daemon=True)

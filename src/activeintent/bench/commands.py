@@ -43,7 +43,14 @@ def bench(
 ) -> None:
     """Compare methods on identical work; writes results.jsonl, report.md, success_vs_rounds.png."""
     from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
 
     from activeintent.bench.report import plot_success_vs_rounds, write_report
     from activeintent.bench.runner import BenchOptions, run_bench

@@ -47,7 +47,7 @@ class Learner(ABC):
     signal: Literal["preference", "stop"] = "stop"
     retriever: str | None = None  # which retriever produced r (stop methods), for the logs
 
-    def execution_failed(self, goal: str, reason: str) -> None:
+    def execution_failed(self, goal: str, reason: str) -> None:  # noqa: B027 - optional hook
         """The executor could not turn goal y into motion; the next estimate should be simpler."""
 
     def stats(self) -> dict:

@@ -24,9 +24,14 @@ from activeintent.learners.retrievers import (
     symbolic_retrieval,
     vision_messages,
 )
-from activeintent.learners.schemas import IntentionAnswer, RetrievalAnswer, goals_schema, scene_schema
+from activeintent.learners.schemas import (
+    IntentionAnswer,
+    RetrievalAnswer,
+    goals_schema,
+    scene_schema,
+)
 from activeintent.llm.base import ChatModel, ImagePart, Message, ModelError, TextPart
-from activeintent.signals import PreferenceFeedback, StopFeedback
+from activeintent.signals import StopFeedback
 from activeintent.sim.trajectory import Trajectory
 from activeintent.world import ALL_OBJECTS, Scene, SceneError, WorldState, describe_state, layout
 
@@ -96,7 +101,7 @@ class _ModelLearner(Learner):
     # -- prompts -----------------------------------------------------------------------------
     def history_text(self) -> str:
         lines = []
-        for rec, r in zip(self.history, self.retrieved):
+        for rec, r in zip(self.history, self.retrieved, strict=False):
             lines.append(self._round_text(rec, r))
         lines += self.notes
         return "\n".join(lines)
@@ -219,7 +224,7 @@ class MllmLlmLearner(_StopLearner):
             traj, goal = trajectories[0], record.estimate.goals[0]
             ph = prompt_h(traj, h, goal, self.config.epsilon)
             if self.retriever == "vision":
-                past = "\n".join(f"y: {rec.estimate.goals[0]}; r: {rr}" for rec, rr in zip(self.history, self.retrieved) if rr)
+                past = "\n".join(f"y: {rec.estimate.goals[0]}; r: {rr}" for rec, rr in zip(self.history, self.retrieved, strict=False) if rr)
                 size = (self.config.image_size, self.config.image_size)
                 r = self._ask("eq4_retrieve", self.vlm, vision_messages(ph, traj, past, size), RetrievalAnswer).retrieved
             else:

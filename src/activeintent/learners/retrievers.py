@@ -14,8 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
-from activeintent.llm.base import ImagePart, Message, TextPart
 from activeintent.learners import prompts
+from activeintent.llm.base import ImagePart, Message, TextPart
 from activeintent.signals import StopFeedback
 from activeintent.sim.trajectory import Trajectory
 from activeintent.world import describe_skill, describe_state, relations

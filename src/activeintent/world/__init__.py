@@ -4,7 +4,9 @@ Everything here is pure Python + numpy so that intentions, users, learners and t
 symbolic world model can reason about the table without a simulator.
 """
 
-from activeintent.world.colors import COLORS, COLOR_NAMES, COOL_COLORS, WARM_COLORS
+from activeintent.world.colors import COLOR_NAMES, COLORS, COOL_COLORS, WARM_COLORS
+from activeintent.world.predict import SkillFailure, apply_plan, apply_skill, target_position
+from activeintent.world.relations import Relations, describe_state, relations, table_position_name
 from activeintent.world.scene import (
     ALL_OBJECTS,
     BLOCK_SIZE,
@@ -28,8 +30,6 @@ from activeintent.world.skills import (
     describe_skill,
 )
 from activeintent.world.state import WorldState
-from activeintent.world.relations import Relations, describe_state, relations, table_position_name
-from activeintent.world.predict import SkillFailure, apply_plan, apply_skill, target_position
 
 __all__ = [
     "ALL_OBJECTS", "BLOCK_SIZE", "BOUNDS", "BOWL_INNER_RADIUS", "BOWL_RADIUS", "COLORS",

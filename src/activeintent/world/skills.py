@@ -6,7 +6,7 @@ Sides: left/right along x, front/behind along y (behind = towards the top side).
 
 from __future__ import annotations
 
-from typing import Annotated, Literal, Union
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, Field
 
@@ -59,7 +59,7 @@ class PutAt(BaseModel):
     position: str | tuple[float, float]
 
 
-Skill = Annotated[Union[PutIn, PutOn, PutNextTo, PutAt], Field(discriminator="skill")]
+Skill = Annotated[PutIn | PutOn | PutNextTo | PutAt, Field(discriminator="skill")]
 
 
 class Plan(BaseModel):
