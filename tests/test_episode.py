@@ -42,17 +42,19 @@ def scripted_answers(messages, schema):
     raise AssertionError(title)
 
 
-def run(method, env, tmp_path, model, intention="color-match", rounds=2, seed=3, track_progress=True):
+def run(method, env, tmp_path, model, intention="color-match", rounds=2, seed=3, track_progress=True,
+        design_scenes=True, goal_retries=1):
     seeds = EpisodeSeeds.from_seed(seed)
     it = get_intention(intention)
     user = make_user(SIGNAL[method], it, UserConfig(), seed=seeds.user)
-    learner = make_learner(method, llm=model, seed=seeds.learner)
+    learner = make_learner(method, llm=model, seed=seeds.learner, design_scenes=design_scenes)
     def usage():
         t = model.usage.snapshot()
         return t.calls, t.prompt_tokens, t.completion_tokens
 
     episode = Episode(learner, it, user, make_executor("plan", model=model), env,
-                      EpisodeConfig(rounds=rounds, seed=seed, save_videos=False, track_progress=track_progress), tmp_path,
+                      EpisodeConfig(rounds=rounds, seed=seed, save_videos=False, track_progress=track_progress,
+                                    max_goal_retries=goal_retries), tmp_path,
                       usage=usage)
     return episode.run()
 
@@ -106,7 +108,9 @@ def test_paper_learner_full_episode_with_embedded_model(method, env, tmp_path):
     from activeintent.llm.registry import load_model
 
     model = load_model("embedded", cache_path=tmp_path / "cache.sqlite", cache_mode="record")
-    result = run(method, env, tmp_path / "run", model, rounds=1, track_progress=False)
+    # One round; only mllm-llm designs its scene (the other two save that call on this slow model).
+    fast = dict(rounds=1, track_progress=False, design_scenes=method == "mllm-llm", goal_retries=0)
+    result = run(method, env, tmp_path / "run", model, **fast)
     assert result.error is None, result.error
     assert result.llm_calls > 0 and result.rounds_used >= 1
     rounds = read_rounds(tmp_path / "run" / "rounds.jsonl")
@@ -115,7 +119,7 @@ def test_paper_learner_full_episode_with_embedded_model(method, env, tmp_path):
         return
     # Warm cache: the same seed makes identical calls and gets identical answers, no model work.
     before = model.usage.snapshot()
-    again = run(method, env, tmp_path / "again", model, rounds=1, track_progress=False)
+    again = run(method, env, tmp_path / "again", model, **fast)
     assert model.usage.diff(before).cache_misses == 0
     assert strip_timing(read_rounds(tmp_path / "again" / "rounds.jsonl")) == strip_timing(rounds)
     assert again.final_goal == result.final_goal

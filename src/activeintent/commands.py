@@ -85,7 +85,9 @@ def run(
         console.print(f"[red]model error:[/red] {err}")
         raise typer.Exit(3) from None
     if result.error:
-        console.print(f"[red]episode ended early:[/red] {result.error}")
+        # The episode log is kept; a model that failed for good is still a failed run.
+        console.print(f"[red]episode ended early:[/red] {result.error} (log: {out_dir})")
+        raise typer.Exit(3)
     verdict = "[green]SUCCESS[/green]" if result.success else "[red]FAILURE[/red]"
     console.print(
         f"{verdict} {result.method} on {result.intention}: final z = “{result.final_preference}” · "

@@ -1,0 +1,43 @@
+"""`activeintent run` end to end through the CLI: outputs, exit codes, clear errors."""
+
+from __future__ import annotations
+
+import json
+
+from typer.testing import CliRunner
+
+from activeintent.cli import app
+
+runner = CliRunner()
+
+
+def test_run_writes_summary_rounds_and_gifs(tmp_path):
+    out = tmp_path / "run"
+    res = runner.invoke(app, ["run", "--method", "bayes-stop", "--intention", "stack", "--rounds", "2",
+                              "--llm", "none", "--seed", "1", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["method"] == "bayes-stop" and summary["intention"] == "stack"
+    assert summary["signals_used"] <= 2 and summary["final_goal"]
+    assert len((out / "rounds.jsonl").read_text().splitlines()) == summary["rounds_used"]
+    assert list(out.glob("round1_*.gif")) and (out / "final.gif").exists()
+    assert ("SUCCESS" if summary["success"] else "FAILURE") in res.output
+
+
+def test_bad_options_exit_2_with_the_valid_choices(tmp_path):
+    res = runner.invoke(app, ["run", "--method", "guess", "--out", str(tmp_path)])
+    assert res.exit_code == 2 and "bayes-stop" in res.output and "mllm-llm" in res.output
+    res = runner.invoke(app, ["run", "--method", "bayes-stop", "--intention", "stak", "--llm", "none", "--out", str(tmp_path)])
+    assert res.exit_code == 2 and "color-match" in res.output
+    res = runner.invoke(app, ["run", "--method", "preference", "--llm", "none", "--out", str(tmp_path)])
+    assert res.exit_code == 2 and "--llm" in res.output
+    res = runner.invoke(app, ["run", "--llm", "chatgpt", "--out", str(tmp_path)])
+    assert res.exit_code == 2 and "openai:" in res.output
+
+
+def test_unreachable_model_exits_3(tmp_path):
+    res = runner.invoke(app, ["run", "--method", "preference", "--llm", "openai:gpt-x", "--base-url",
+                              "http://127.0.0.1:9/v1", "--cache-mode", "off", "--rounds", "1", "--out", str(tmp_path)],
+                        env={"OPENAI_API_KEY": "test"})
+    assert res.exit_code == 3, res.output
+    assert "model" in res.output.lower()
