@@ -13,7 +13,7 @@ from pydantic import BaseModel, Field
 
 from activeintent.episode import Episode, EpisodeConfig, EpisodeSeeds, RoundLog
 
-DEFAULT_METHOD = "mllm-llm"
+DEFAULT_METHOD = "bayes-stop"  # beats the paper's methods in the benchmark (README, Results)
 DEFAULT_INTENTION = "color-match"
 
 
