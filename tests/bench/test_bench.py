@@ -97,3 +97,34 @@ def test_parallel_jobs_give_the_same_results(tmp_path):
     pick = lambda r: (key(r), r["success"], r["final_goal"], r["signals_used"])  # noqa: E731
     assert sorted(map(pick, serial)) == sorted(map(pick, parallel))
     assert Path(tmp_path / "parallel" / "episodes").is_dir()
+
+
+CRASHING_INTENTION = '''
+import os
+
+from activeintent.intentions.registry import get_intention
+
+_stack = get_intention("stack")
+
+
+class Crash(type(_stack)):
+    """Behaves as `stack`, but its worker process dies (as on a native crash) when sampling."""
+
+    name = "crash"
+
+    def sample_scene(self, rng):
+        os._exit(3)
+'''
+
+
+@pytest.mark.slow
+def test_a_dying_worker_is_recorded_and_the_bench_goes_on(tmp_path):
+    path = tmp_path / "crash.py"
+    path.write_text(CRASHING_INTENTION)
+    options = BenchOptions(methods=["bayes-stop"], intentions=["stack"], intention_files=[f"{path}:Crash"],
+                           trials=1, seed=5, jobs=2, run=RunOptions(rounds=1, save_videos=False, llm="none"))
+    records = run_bench(options, tmp_path / "out")
+    by = {r["intention"]: r for r in records}
+    assert len(records) == 2
+    assert "worker process died" in by[f"{path}:Crash"]["error"]
+    assert not by["stack"].get("error")

@@ -15,14 +15,14 @@ import os
 import traceback
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from multiprocessing import get_context
 from pathlib import Path
 
 from pydantic import BaseModel, Field
 
-from activeintent.runner import RunOptions, UserOptions
-
-PAPER_INTENTIONS = ("align", "stack", "color-match", "color-mismatch")
+from activeintent.intentions.registry import PAPER_INTENTIONS
+from activeintent.runner import RunOptions
 
 
 class WorkItem(BaseModel):
@@ -151,16 +151,35 @@ def _execute(todo: list[WorkItem], run: RunOptions, seed: int, out: Path, jobs: 
         for item in todo:
             yield run_item(item, run, seed, str(out))
         return
+    queue = list(todo)
+    while queue:
+        suspects: list[WorkItem] = []
+        with _pool(jobs) as pool:
+            pending: dict[Future, WorkItem] = {}
+            while (queue or pending) and not suspects:
+                while queue and len(pending) < jobs:
+                    item = queue.pop(0)
+                    pending[pool.submit(run_item, item, run, seed, str(out))] = item
+                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for fut in finished:
+                    if isinstance(fut.exception(), BrokenProcessPool):
+                        suspects = list(pending.values())  # a worker died: which episode killed it?
+                        break
+                    pending.pop(fut)
+                    yield fut.result()
+        # Run each episode that was in flight alone: the one that dies again is recorded as an
+        # error (e.g. a native crash), the others give their results; then go on in parallel.
+        for item in suspects:
+            with _pool(1) as alone:
+                fut = alone.submit(run_item, item, run, seed, str(out))
+                wait([fut])
+                if isinstance(fut.exception(), BrokenProcessPool):
+                    yield {"method": item.method, "intention": item.intention, "trial": item.trial,
+                           "success": False, "success_rate": 0.0, "error": "worker process died"}
+                else:
+                    yield fut.result()
+
+
+def _pool(jobs: int) -> ProcessPoolExecutor:
     # spawn: every worker starts clean (own PyBullet client, own llama.cpp handle).
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
-        pending: set[Future] = set()
-        queue = list(todo)
-        while queue or pending:
-            while queue and len(pending) < jobs:
-                pending.add(pool.submit(run_item, queue.pop(0), run, seed, str(out)))
-            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-            for fut in finished:
-                yield fut.result()
-
-
-__all__ = ["BenchOptions", "PAPER_INTENTIONS", "UserOptions", "WorkItem", "episode_seed", "read_results", "run_bench"]
+    return ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn"))
