@@ -70,8 +70,7 @@ def run(
             "new scene" if h.get("new_scene") else "no stop" if h.get("stop_time") is None
             else f"stop at {h['stop_time']:.2f} s (step {(h.get('step_index') or 0) + 1})")
         table.add_row(str(log.round), log.preference, "\n".join(log.goals), signal, log.retrieved or "")
-        if signal != "new scene" and signal != "new_scene":
-            progress.update(task, advance=1)  # the bar counts signals; new-scene answers are free
+        progress.update(task, completed=log.signals_used)  # new-scene answers are free up to a cap
 
     try:
         with console.status("loading models and simulator…"):

@@ -83,6 +83,7 @@ class RoundLog(BaseModel):
     retriever: str | None
     done: bool
     progress_success: float | None = None
+    signals_used: int = 0  # signals given so far, this round included
     calls: list[dict] = Field(default_factory=list)
     timing: dict[str, float] = Field(default_factory=dict)
 
@@ -235,6 +236,8 @@ class Episode:
                 # New-scene answers are free up to max_new_scenes; past that they use the budget.
                 if not after_new_scene or new_scenes > cfg.max_new_scenes:
                     signals += 1
+                log.signals_used = signals
+                self._log_round(log)
                 if log.done:
                     break
         except ModelError as err:
@@ -323,12 +326,14 @@ class Episode:
             calls=calls,
             timing={k: round(v - t0[k], 4) for k, v in self.clock.split.items()},
         )
+        return log
+
+    def _log_round(self, log: RoundLog) -> None:
         if self.out is not None:
             with (self.out / "rounds.jsonl").open("a") as f:
                 f.write(log.model_dump_json() + "\n")
         if self.on_round:
             self.on_round(log)
-        return log
 
     def _probe(self, scene: Scene) -> float:
         """Success of the current estimate on the first test scene, predicted symbolically."""
