@@ -128,3 +128,11 @@ def test_a_dying_worker_is_recorded_and_the_bench_goes_on(tmp_path):
     assert len(records) == 2
     assert "worker process died" in by[f"{path}:Crash"]["error"]
     assert not by["stack"].get("error")
+
+
+def test_resume_refuses_other_settings(tmp_path):
+    run_bench(BenchOptions(**{**tiny().model_dump(), "trials": 0}), tmp_path)  # writes bench.json only
+    other = tiny()
+    other.run.rounds = 3
+    with pytest.raises(ValueError, match="other settings"):
+        run_bench(other, tmp_path)

@@ -89,7 +89,12 @@ def bench(
             else:
                 progress.update(task, completed=finished)
 
-        records = run_bench(options, out, on_done)
+        try:
+            records = run_bench(options, out, on_done)
+        except ValueError as err:
+            progress.stop()
+            console.print(f"[red]error:[/red] {err}")
+            raise typer.Exit(2) from None
     all_intentions = intention_list + list(intention_file or [])
     settings = {"trials": trials, "rounds": rounds, "llm": llm, "vlm": vlm or llm, "executor": executor,
                 "retriever": retriever, "user": run.user.model_dump(), "seed": seed}

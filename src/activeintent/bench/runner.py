@@ -124,6 +124,7 @@ def run_bench(
     """Run what is missing from ``out/results.jsonl``; returns all records."""
     out.mkdir(parents=True, exist_ok=True)
     results_path = out / "results.jsonl"
+    _check_same_settings(options, out / "bench.json")
     (out / "bench.json").write_text(options.model_dump_json(indent=2))
     records = read_results(results_path)
     if options.retry_errors:
@@ -144,6 +145,25 @@ def run_bench(
         if on_done:
             on_done(record, finished, total)
     return records
+
+
+# Options that change what an episode does; methods, intentions and trials may grow on resume.
+_SETTINGS = ("seed", "run")
+
+
+def _check_same_settings(options: BenchOptions, path: Path) -> None:
+    """Resuming into a folder made with other settings would mix incomparable episodes."""
+    if not path.exists():
+        return
+    before = json.loads(path.read_text())
+    now = json.loads(options.model_dump_json())
+    changed = [k for k in _SETTINGS if before.get(k) != now.get(k)]
+    if changed:
+        diff = "; ".join(f"{k}: {before.get(k)} → {now.get(k)}" for k in changed)
+        raise ValueError(
+            f"{path.parent} holds results made with other settings ({diff}). "
+            "Use another --out, or the same settings to resume."
+        )
 
 
 def _execute(todo: list[WorkItem], run: RunOptions, seed: int, out: Path, jobs: int) -> Iterator[dict]:
