@@ -160,3 +160,14 @@ def test_intentions_command_lists_all_and_user_file():
     result = runner.invoke(_cli(), ["intentions", "--intention-file", f"{EXAMPLE}:Nope"], env={"COLUMNS": "200"})
     assert result.exit_code == 2
     assert "defines no 'Nope'" in result.output
+
+
+def test_grammar_only_example_intentions_load_and_are_not_named_ones():
+    from pathlib import Path
+
+    from activeintent.intentions.registry import INTENTION_NAMES, load_intention_file
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "grammar_intentions.py"
+    for name in ("PINK_BOWL", "NEXT_TO_YELLOW", "LEFT_SIDE", "WARM_LEFT_COOL_RIGHT"):
+        intention = load_intention_file(f"{path}:{name}")
+        assert intention.name not in INTENTION_NAMES and intention.description
