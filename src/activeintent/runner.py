@@ -109,13 +109,13 @@ def build_episode(
     intention = resolve_intention(options.intention or (None if options.intention_file else DEFAULT_INTENTION),
                                   options.intention_file)
     models = Models(options)
+    seeds = EpisodeSeeds.from_seed(options.seed)
     # Bayesian methods need no model; given one, it proposes open-ended hypotheses.
     llm = models.llm
     learner = make_learner(options.method, llm=llm, vlm=models.vlm, retriever=options.retriever,
-                           seed=EpisodeSeeds.from_seed(options.seed).learner,
-                           design_scenes=options.design_scenes, epsilon=options.epsilon)
+                           seed=seeds.learner, design_scenes=options.design_scenes,
+                           epsilon=options.epsilon)
     executor = make_executor(options.executor, model=llm)
-    seeds = EpisodeSeeds.from_seed(options.seed)
     if user is None:
         u = options.user
         user = make_user(SIGNAL[options.method], intention,

@@ -44,6 +44,13 @@ from activeintent.world import (
 MIN_SPACING = 0.03  # two blocks on one surface closer than this would overlap
 
 
+def _two_to_four_blocks(rng: np.random.Generator) -> Scene:
+    """2–4 blocks and up to 2 bowls (3–5 objects): the scenes of the row and tower intentions."""
+    n_blocks = 2 + int(rng.integers(0, 3))
+    n_bowls = int(rng.integers(max(0, 3 - n_blocks), 6 - n_blocks))
+    return _blocks_and_bowls(rng, n_blocks, min(n_bowls, 2))
+
+
 def _blocks_and_bowls(rng: np.random.Generator, n_blocks: int, n_bowls: int) -> Scene:
     colors = [str(c) for c in rng.choice(COLOR_NAMES, size=n_blocks, replace=False)]
     bowls = [str(c) for c in rng.choice(COLOR_NAMES, size=n_bowls, replace=False)]
@@ -110,9 +117,7 @@ class _LineIntention(Intention):
         return len(scene.blocks) >= 2
 
     def sample_scene(self, rng: np.random.Generator) -> Scene:
-        n_blocks = 2 + int(rng.integers(0, 3))
-        n_bowls = int(rng.integers(max(0, 3 - n_blocks), 6 - n_blocks))
-        return _blocks_and_bowls(rng, n_blocks, min(n_bowls, 2))
+        return _two_to_four_blocks(rng)
 
     def plan(self, state: WorldState) -> list[Skill] | None:
         if not state.blocks:
@@ -198,9 +203,7 @@ class Stack(Intention):
         return len(scene.blocks) >= 2
 
     def sample_scene(self, rng: np.random.Generator) -> Scene:
-        n_blocks = 2 + int(rng.integers(0, 3))
-        n_bowls = int(rng.integers(max(0, 3 - n_blocks), 6 - n_blocks))
-        return _blocks_and_bowls(rng, n_blocks, min(n_bowls, 2))
+        return _two_to_four_blocks(rng)
 
     def plan(self, state: WorldState) -> list[Skill] | None:
         if not state.blocks:
