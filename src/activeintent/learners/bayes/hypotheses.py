@@ -267,13 +267,19 @@ def _bank(seed: int, others: int) -> list[tuple[Scene, list[Facts]]]:
     return bank
 
 
-def _cache_file(seed: int, others: int) -> Path:
-    src = Path(__file__).parent
-    digest = hashlib.sha256()
-    for name in ("hypotheses.py", "behaviours.py", "facts.py", "planning.py"):
-        digest.update((src / name).read_bytes())
-    for mod in ("predict.py", "relations.py", "scene.py", "skills.py", "colors.py"):
-        digest.update((Path(layout.__code__.co_filename).parent / mod).read_bytes())
+def _cache_sources() -> list[Path]:
+    """Every source file the cached result depends on: the grammar, all of world/, intentions/."""
+    pkg = Path(__file__).resolve().parents[2]
+    grammar = ("hypotheses.py", "behaviours.py", "facts.py", "planning.py")
+    bayes = [pkg / "learners" / "bayes" / name for name in grammar]
+    return bayes + sorted((pkg / "world").glob("*.py")) + sorted((pkg / "intentions").glob("*.py"))
+
+
+def _cache_file(seed: int, others: int, sources: list[Path] | None = None) -> Path:
+    digest = hashlib.sha256(f"numpy {np.__version__}".encode())  # the bank is drawn with numpy's rng
+    for path in sources if sources is not None else _cache_sources():
+        digest.update(f"\0{path.parent.name}/{path.name}\0".encode())
+        digest.update(path.read_bytes())
     root = Path(os.environ.get("ACTIVEINTENT_CACHE", Path.home() / ".cache" / "activeintent"))
     return root / f"bayes-hypotheses-{digest.hexdigest()[:16]}-{seed}-{others}.json"
 
@@ -283,7 +289,7 @@ def distinct_names(seed: int = 0, others: int = 6) -> list[str]:
 
     Two hypotheses are the same when they agree on feasibility and on ``satisfied`` for every
     bank state; of each such set the one with the shortest description is kept. The result is
-    cached on disk (keyed by the source of the grammar and the world model): it takes seconds.
+    cached on disk (keyed by the source of the grammar, world/ and intentions/): it takes seconds.
     """
     path = _cache_file(seed, others)
     try:
