@@ -1,5 +1,59 @@
+"""Session set-up shared by every test: import paths, plugins, and a private cache folder."""
+
+from __future__ import annotations
+
+import os
+import shutil
 import sys
+import tempfile
 from pathlib import Path
 
-# tests import helpers.py as a plain module
+import pytest
+
+# tests import helpers.py (and the suite_rules plugin) as plain modules
 sys.path.insert(0, str(Path(__file__).parent))
+
+# suite_rules: per-test timeouts, and CI failing on missing core dependencies.
+# pytester: tests of those rules run small pytest sessions of their own.
+pytest_plugins = ["pytester", "suite_rules"]
+
+# The code keeps its caches under the home folder (~/.cache/activeintent: the hypothesis space,
+# model responses, the assembled GGUF, the light Panda model) or under ACTIVEINTENT_CACHE.
+# A run points all of them at a fresh temporary home, so it neither reads stale results from the
+# user's caches nor writes into them. This happens in pytest_configure rather than in a fixture
+# because collection already imports the code (and could read a cache).
+_CACHE_VARIABLES = ("HOME", "XDG_CACHE_HOME", "ACTIVEINTENT_CACHE")
+_saved_environment: dict[str, str | None] = {}
+_temporary_root: list[Path] = []
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    root = Path(tempfile.mkdtemp(prefix="activeintent-tests-"))
+    home = root / "home"
+    values = {
+        "HOME": home,
+        "XDG_CACHE_HOME": home / ".cache",
+        "ACTIVEINTENT_CACHE": home / ".cache" / "activeintent",
+    }
+    values["ACTIVEINTENT_CACHE"].mkdir(parents=True)
+    for name, value in values.items():
+        _saved_environment[name] = os.environ.get(name)
+        os.environ[name] = str(value)
+    _temporary_root.append(root)
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    for name, value in _saved_environment.items():
+        if value is None:
+            os.environ.pop(name, None)
+        else:
+            os.environ[name] = value
+    _saved_environment.clear()
+    while _temporary_root:
+        shutil.rmtree(_temporary_root.pop(), ignore_errors=True)
+
+
+@pytest.fixture(scope="session")
+def run_home() -> Path:
+    """The temporary home folder of this run (its .cache holds every cache the code writes)."""
+    return Path(os.environ["HOME"])

@@ -1,6 +1,5 @@
 from __future__ import annotations
 
-import os
 import socket
 
 import pytest
@@ -16,29 +15,52 @@ def state() -> WorldState:
     return WorldState(positions=layout(scene, 3))
 
 
-@pytest.fixture(scope="session")
-def secret_env():
-    """A fake secret in the parent's environment before any sandbox worker starts."""
-    os.environ[SECRET_NAME] = SECRET_VALUE
-    yield SECRET_VALUE
-    os.environ.pop(SECRET_NAME, None)
+@pytest.fixture
+def secret_env(monkeypatch):
+    """A fake secret in the parent's environment during one test; monkeypatch takes it out after."""
+    monkeypatch.setenv(SECRET_NAME, SECRET_VALUE)
+    return SECRET_VALUE
 
 
 def _limits() -> SandboxLimits:
     return SandboxLimits(cpu_seconds=1, wall_seconds=4.0, memory_mb=128)
 
 
-@pytest.fixture(scope="session")
-def sandbox(secret_env):
-    with Sandbox(_limits()) as sb:
-        yield sb
+def _started_with_secret(**kwargs) -> Sandbox:
+    """A sandbox whose worker started while the fake secret was in the environment; the
+    variable is restored as soon as the worker is up, not at the end of the session."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv(SECRET_NAME, SECRET_VALUE)
+        sb = Sandbox(_limits(), **kwargs)
+        sb.start()
+    return sb
 
 
 @pytest.fixture(scope="session")
-def unguarded_sandbox(secret_env):
+def _shared_sandbox():
+    sb = _started_with_secret()
+    yield sb
+    sb.close()
+
+
+@pytest.fixture(scope="session")
+def _shared_unguarded_sandbox():
+    sb = _started_with_secret(guard=False)
+    yield sb
+    sb.close()
+
+
+@pytest.fixture
+def sandbox(_shared_sandbox, secret_env):
+    """The session's sandbox; the secret is in the parent's environment while the test runs
+    (a worker restarted after a crash starts with it too)."""
+    return _shared_sandbox
+
+
+@pytest.fixture
+def unguarded_sandbox(_shared_unguarded_sandbox, secret_env):
     """No AST allow-list and all builtins: what is left is the OS-level containment."""
-    with Sandbox(_limits(), guard=False) as sb:
-        yield sb
+    return _shared_unguarded_sandbox
 
 
 @pytest.fixture(scope="session")
