@@ -3,79 +3,125 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
 
 import typer
 
 from activeintent import options as opt
-from activeintent.runner import DEFAULT_METHOD
+from activeintent.options import D
 
 
 def register(app: typer.Typer) -> None:
     app.command(name="run")(run)
+    app.command(name="methods")(methods)
+
+
+def methods() -> None:
+    """List the methods (learners) with their signal and whether they need a model."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from activeintent.learners.registry import METHODS, get_method
+
+    table = Table(title="methods")
+    for col in ("method", "family", "signal", "needs a model", "what it does"):
+        table.add_column(col, overflow="fold")
+    for name in METHODS.names():
+        m = get_method(name)
+        table.add_row(name, m.family, m.signal, "yes" if m.needs_llm else "no", m.help)
+    Console().print(table)
+
+
+class LiveTable:
+    """An episode observer: a rich table of rounds (z, y, h, r) and a progress bar of signals."""
+
+    def __init__(self, console, method: str, budget: int, seed: int):
+        from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+        from rich.table import Table
+
+        self.table = Table(title=f"{method} on a hidden intention · budget {budget} signals · seed {seed}", expand=True)
+        for col, style in (("round", "bold"), ("z (estimated intention)", "cyan"), ("y (shown)", ""),
+                           ("h (answer)", "magenta"), ("r (retrieved)", "dim"), ("success@k", "green")):
+            self.table.add_column(col, style=style, overflow="fold")
+        self.progress = Progress(TextColumn("signals"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
+                                 TimeElapsedColumn(), console=console)
+        self.task = self.progress.add_task("signals", total=budget)
+        self._pending = None
+
+    def answered(self, log) -> None:
+        from rich.markup import escape
+
+        from activeintent.episode import answer_kind_from_dump
+
+        h = log.answer
+        kind = answer_kind_from_dump(h)
+        text = f"stop at {h['stop_time']:.2f} s" if kind == "stop" else kind.replace("_", " ")
+        if not log.counted:
+            text += " (free)"
+        goals = "\n".join(f"{lab}: {g}" for lab, g in zip(log.labels, log.goals, strict=False))
+        self._pending = [str(log.round), escape(log.z), escape(goals), text, escape(log.retrieved or "")]
+        if not log.counted:
+            self.table.add_row(*self._pending, "")
+            self._pending = None
+        self.progress.update(self.task, completed=log.signals_used)
+
+    def scored(self, k: int, rate) -> None:
+        if self._pending is not None:
+            self.table.add_row(*self._pending, "–" if rate is None else f"{rate:.2f}")
+            self._pending = None
+        elif k == 0:
+            self.table.add_row("0", "(prior, before any signal)", "", "", "", "–" if rate is None else f"{rate:.2f}")
 
 
 def run(
-    method: Annotated[str, typer.Option("--method", help="preference | mllm | mllm-llm | bayes-preference | bayes-stop")] = DEFAULT_METHOD,
+    method: opt.Method = D.method,
     intention: opt.Intention = None,
     intention_file: opt.IntentionFile = None,
-    rounds: opt.Rounds = 5,
-    seed: opt.Seed = 0,
-    test_scenes: Annotated[int, typer.Option("--test-scenes", min=1, help="Fresh scenes the final answer is tested on")] = 1,
-    llm: opt.Llm = "embedded",
+    plugin: opt.Plugin = None,
+    budget: opt.Budget = D.budget,
+    seed: opt.Seed = D.seed,
+    test_scenes: opt.TestScenes = D.test_scenes,
+    env: opt.Env = D.env,
+    user: opt.User = D.user,
+    new_scene: opt.NewScene = D.new_scene,
+    prior: opt.Prior = D.prior,
+    llm: opt.Llm = D.llm,
     vlm: opt.Vlm = None,
     base_url: opt.BaseUrl = None,
     cache: opt.Cache = None,
-    cache_mode: opt.CacheMode = "record",
-    executor: opt.Executor = "plan",
-    retriever: opt.Retriever = "symbolic",
-    epsilon: Annotated[float, typer.Option("--epsilon", help="ε: seconds before the stop for image I_b")] = 2.0,
-    user_beta: opt.UserBeta = float("inf"),
-    reaction_delay: opt.ReactionDelay = "0.5,0.15",
-    false_stop: opt.FalseStop = 0.0,
-    missed_stop: opt.MissedStop = 0.0,
-    design_scenes: Annotated[bool, typer.Option(help="Let the learner choose each round's objects")] = True,
-    out: Annotated[Path | None, typer.Option("--out", help="Output folder (default runs/<method>-<intention>-seed<S>)")] = None,
+    cache_mode: opt.CacheMode = D.cache_mode,
+    executor: opt.Executor = D.executor,
+    retriever: opt.Retriever = D.retriever,
+    epsilon: opt.Epsilon = D.epsilon,
+    video: opt.Video = D.video,
+    design_scenes: bool = typer.Option(D.design_scenes, help="Let the learner choose each round's objects"),
+    out: opt.Out = None,
 ) -> None:
     """Run one episode: the learner asks, a simulated user with a hidden intention answers."""
     from rich.console import Console, Group
     from rich.live import Live
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
-    from rich.table import Table
 
     from activeintent.llm.base import ModelError
-    from activeintent.runner import RunOptions, build_episode
+    from activeintent.runner import DEFAULT_INTENTION, build_episode
 
     console = Console()
-    options = RunOptions(
-        method=method, intention=intention, intention_file=intention_file, rounds=rounds, seed=seed,
-        test_scenes=test_scenes, llm=llm, vlm=vlm, base_url=base_url, cache=cache, cache_mode=cache_mode,
-        executor=executor, retriever=retriever, epsilon=epsilon, design_scenes=design_scenes,
-        user=opt.user_options(user_beta, reaction_delay, false_stop, missed_stop),
-    )
-    name = intention or (Path(intention_file.split(":")[0]).stem if intention_file else "color-match")
+    try:
+        options = opt.run_options(
+            method=method, intention=intention, intention_file=intention_file, plugins=plugin, budget=budget,
+            seed=seed, test_scenes=test_scenes, env=env, user=user, new_scene=new_scene, prior=prior, llm=llm,
+            vlm=vlm, base_url=base_url, cache=cache, cache_mode=cache_mode, executor=executor,
+            retriever=retriever, epsilon=epsilon, video=video, design_scenes=design_scenes,
+            )
+    except ValueError as err:
+        console.print(f"[red]error:[/red] {err}")
+        raise typer.Exit(2) from None
+    name = intention or (Path(intention_file.split(":")[0]).stem if intention_file else DEFAULT_INTENTION)
     out_dir = out or Path("runs") / f"{method}-{name}-seed{seed}"
-
-    table = Table(title=f"{method} on a hidden intention · {rounds} rounds · seed {seed}", expand=True)
-    for col, style in (("round", "bold"), ("z (estimated intention)", "cyan"), ("y (goal)", ""),
-                       ("h (signal)", "magenta"), ("r (retrieved)", "dim")):
-        table.add_column(col, style=style, overflow="fold")
-    progress = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
-                        TimeElapsedColumn(), console=console)
-    task = progress.add_task("signals", total=rounds)
-
-    def on_round(log) -> None:
-        h = log.feedback
-        signal = h.get("choice") if h.get("kind") == "preference" else (
-            "new scene" if h.get("new_scene") else "no stop" if h.get("stop_time") is None
-            else f"stop at {h['stop_time']:.2f} s (step {(h.get('step_index') or 0) + 1})")
-        table.add_row(str(log.round), log.preference, "\n".join(log.goals), signal, log.retrieved or "")
-        progress.update(task, completed=log.signals_used)  # new-scene answers are free up to a cap
-
+    live = LiveTable(console, method, budget, seed)
     try:
         with console.status("loading models and simulator…"):
-            episode = build_episode(options, out_dir, on_round=on_round)
-        with Live(Group(table, progress), console=console, refresh_per_second=4):
+            episode = build_episode(options, out_dir, observers=[live])
+        with Live(Group(live.table, live.progress), console=console, refresh_per_second=4,
+                  transient=not console.is_terminal):
             result = episode.run()
     except (ValueError, FileNotFoundError) as err:
         console.print(f"[red]error:[/red] {err}")
@@ -83,12 +129,22 @@ def run(
     except ModelError as err:
         console.print(f"[red]model error:[/red] {err}")
         raise typer.Exit(3) from None
+    finally:
+        if "episode" in locals():
+            episode.env.close()
+    if not console.is_terminal:
+        console.print(live.table)
     if result.error:
-        # The episode log is kept; a model that failed for good is still a failed run.
         console.print(f"[red]episode ended early:[/red] {result.error} (log: {out_dir})")
         raise typer.Exit(3)
-    verdict = "[green]SUCCESS[/green]" if result.success else "[red]FAILURE[/red]"
+    errors = result.learner_stats.get("proposal_errors") or []
+    if errors and result.llm_calls == 0:
+        console.print(f"[red]model error:[/red] the model never answered ({errors[0]})")
+        raise typer.Exit(3)
+    rate = "n/a (no test scene feasible)" if result.success is None else f"{result.success:.2f}"
     console.print(
-        f"{verdict} {result.method} on {result.intention}: final z = “{result.final_preference}” · "
-        f"{result.signals_used} signals · {result.llm_calls} model calls · {result.wall_s:.0f} s · {out_dir}/summary.json"
+        f"success@{result.budget} = {rate} on {result.test_scenes - result.test_excluded} test scenes "
+        f"({result.test_excluded} excluded: the hidden intention cannot be shown there) · "
+        f"{result.method} on {result.intention} · final z = “{result.final_z}” · {result.signals_used} signals "
+        f"{dict(result.answers)} · {result.llm_calls} model calls · {result.wall_s:.0f} s · {out_dir}/summary.json"
     )

@@ -1,20 +1,24 @@
-"""One episode (design.md §2): K feedback rounds, then a final test on fresh scenes.
+"""One episode (design.md §2; protocol.py): the only module that knows the learner, the
+executor, the env and the user.
 
-for round in 1..K:
-    scene  = learner.design_scene()        (else sampled; logged)
-    z, y   = learner.estimate(scene)        eq. (1)(2) or (5)(6)
-    τ      = executor(y) → simulator
-    h      = user.respond(τ)
-    r      = learner.observe(h, τ)          eq. (3)(4) for stop methods
-final: a fresh scene feasible for the hidden intention; z, y; executed; success = intention holds.
+    success_at[0] = score(learner's prior answer)
+    while signals < K:
+        scene  = learner.design_scene()            (else sampled; logged)
+        z, y   = learner.estimate(scene)            eq. (1)(2) or (5)(6)
+        τ      = executor(y) → env
+        h      = user.respond(τ)                    every answer is one signal
+        r      = learner.observe(h, τ)              eq. (3)(4) for stop methods
+        success_at[k] = score(learner's current answer on the test scenes)
 
-This is the only module that knows the learner, the executor, the simulator and the user.
+Observers subscribe to events: ``started``, ``shown`` (a query's τ are ready), ``answered``
+(a round's record), ``scored`` (success after signal k) and ``finished``. The live table,
+the web session and the records writer are observers.
 """
 
 from __future__ import annotations
 
-import json
 import time
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,29 +27,39 @@ from typing import Any, Protocol
 import numpy as np
 from pydantic import BaseModel, Field
 
+from activeintent.envs import Env
 from activeintent.intentions.base import Intention
 from activeintent.learners.base import Estimate, Learner, RoundRecord
 from activeintent.llm.base import ModelError
-from activeintent.signals import PreferenceFeedback, StopFeedback
-from activeintent.sim.trajectory import Trajectory
-from activeintent.world import Scene, Skill, WorldState, apply_plan, describe_plan, sample_scene
+from activeintent.protocol import (
+    DEFAULT_BUDGET,
+    DEFAULT_TEST_SCENES,
+    FORMAT_VERSION,
+    FREE_NEW_SCENES,
+    NewSceneRule,
+    sample_round_scene,
+    sample_test_scene,
+)
+from activeintent.signals import Answer
+from activeintent.world import Scene, Skill, WorldState, apply_plan, describe_plan, layout
+from activeintent.world.trajectory import Trajectory
 
 
 class EpisodeConfig(BaseModel):
-    rounds: int = Field(5, ge=1, le=100, description="K: feedback signals the user gives at most")
-    seed: int = 0
-    test_scenes: int = Field(1, ge=1, le=50, description="fresh scenes the final answer is tested on")
-    max_new_scenes: int = Field(3, ge=0, description="'new scene' answers allowed on top of K")
+    budget: int = Field(DEFAULT_BUDGET, ge=0, le=100, description="K: signals the user gives")
+    seed: int = Field(0, ge=0, description="seed of the episode's query scenes, user noise and learner")
+    test_seed: int | None = Field(None, ge=0, description="seed of the test scenes (default: from seed)")
+    test_scenes: int = Field(DEFAULT_TEST_SCENES, ge=1, le=200)
+    new_scene: NewSceneRule = "counted"
+    stop_when_done: bool = Field(False, description="end early when a learner allowed to finish says done (not in benchmarks)")
+    curve: bool = Field(True, description="score after every signal (False: only at k = 0 and K)")
     max_goal_retries: int = Field(1, ge=0, description="re-asks when y cannot be turned into motion")
+    video: str = Field("none", pattern="^(none|final|all)$", description="GIFs written: none, the final test, or all")
     video_fps: int = 10
-    save_videos: bool = True
-    track_progress: bool = Field(False, description="after each round, test the current estimate (symbolically)")
 
 
 class User(Protocol):
-    signal: str
-
-    def respond(self, scene: Scene, trajectories: list[Trajectory]) -> PreferenceFeedback | StopFeedback: ...
+    def respond(self, scene: Scene, trajectories: list[Trajectory]) -> Answer: ...
 
 
 class PlanExecutor(Protocol):
@@ -54,8 +68,7 @@ class PlanExecutor(Protocol):
 
 @dataclass
 class EpisodeSeeds:
-    """Every random choice of an episode flows from one seed. Trial t of every method gets the
-    same seeds, so methods are compared on identical scenes and user noise."""
+    """Every random choice flows from one seed; the test scenes from the trial's test seed."""
 
     scenes: int
     layouts: int
@@ -64,9 +77,11 @@ class EpisodeSeeds:
     test: int
 
     @classmethod
-    def from_seed(cls, seed: int) -> EpisodeSeeds:
-        kids = np.random.SeedSequence(seed).spawn(5)
-        return cls(*(int(k.generate_state(1)[0]) for k in kids))
+    def from_seed(cls, seed: int, test_seed: int | None = None) -> EpisodeSeeds:
+        kids = [int(k.generate_state(1)[0]) for k in np.random.SeedSequence(seed).spawn(5)]
+        if test_seed is not None:
+            kids[4] = int(np.random.SeedSequence(test_seed).generate_state(1)[0])
+        return cls(*kids)
 
 
 class RoundLog(BaseModel):
@@ -74,57 +89,85 @@ class RoundLog(BaseModel):
     scene: list[str]
     scene_source: str
     layout_seed: int
-    preference: str
+    z: str
     goals: list[str]
+    labels: list[str]  # "A", "B" for two trajectories, "y" for one
     plans: list[str]
     failures: list[str | None]
-    feedback: dict
+    executed: list[bool]  # did anything move in each τ?
+    answer: dict
+    counted: bool  # did this answer use the budget?
+    signals_used: int  # counted answers so far, this one included
     retrieved: str | None
     retriever: str | None
     done: bool
-    progress_success: float | None = None
-    signals_used: int = 0  # signals given so far, this round included
+    why: dict = Field(default_factory=dict)
     calls: list[dict] = Field(default_factory=list)
     timing: dict[str, float] = Field(default_factory=dict)
 
 
 class TestLog(BaseModel):
     scene: list[str]
-    preference: str
+    layout_seed: int
+    z: str
     goal: str
     plan: str
     failure: str | None
-    success: bool
-    score: float
-    calls: list[dict] = Field(default_factory=list)
+    feasible: bool  # can the hidden intention be satisfied here? (decided after the answer)
+    success: bool  # symbolic outcome
+    success_physics: bool | None = None  # at k = K in the pybullet env
 
 
 class EpisodeResult(BaseModel):
+    format: int = FORMAT_VERSION
     method: str
     intention: str
     seed: int
-    success: bool
-    success_rate: float
-    rounds_used: int
+    test_seed: int
+    env: str
+    budget: int
+    new_scene: str
+    success: float | None  # success@K: share of feasible test scenes satisfied
+    success_at: list[float | None]
+    success_physics: float | None = None
+    physics_disagreements: int | None = None
+    test_scenes: int
+    test_excluded: int  # infeasible for the hidden intention, not scored
     signals_used: int
-    final_preference: str
-    final_goal: str
-    retriever: str | None
+    answers: dict[str, int] = Field(default_factory=dict)
+    rounds_used: int
+    done_at: int | None = None  # first signal count at which the learner said "done"
+    final_z: str = ""
+    final_goal: str = ""
+    retriever: str | None = None
     llm_calls: int = 0
     prompt_tokens: int = 0
     completion_tokens: int = 0
     wall_s: float = 0.0
     time_split: dict[str, float] = Field(default_factory=dict)
-    per_round_success: list[float] = Field(default_factory=list)
     tests: list[TestLog] = Field(default_factory=list)
     learner_stats: dict = Field(default_factory=dict)
+    user: dict = Field(default_factory=dict)
     error: str | None = None
     config: dict = Field(default_factory=dict)
 
 
+def answer_kind(answer: Answer) -> str:
+    """A short label of an answer, for counts and tables."""
+    if answer.new_scene:
+        return "new_scene"
+    d = answer.model_dump(exclude={"signal", "new_scene"})
+    if "choice" in d:
+        return str(d["choice"])
+    if "stop_time" in d:
+        return "no_stop" if d["stop_time"] is None else "stop"
+    return answer.signal
+
+
 @dataclass
 class _Clock:
-    split: dict[str, float] = field(default_factory=lambda: {"sim_s": 0.0, "render_s": 0.0, "model_s": 0.0})
+    split: dict[str, float] = field(default_factory=lambda: {
+        "env_s": 0.0, "learner_s": 0.0, "executor_s": 0.0, "user_s": 0.0, "scoring_s": 0.0, "video_s": 0.0})
 
     def timed(self, key: str, fn: Callable, *args, **kwargs):
         start = time.perf_counter()
@@ -135,8 +178,8 @@ class _Clock:
 
 
 class Episode:
-    """Runs one episode. ``env`` is a TabletopEnv; ``usage`` returns (calls, prompt, completion)
-    token totals of the models in use so the episode can report its own share."""
+    """Runs one episode. ``usage`` returns (calls, prompt tokens, completion tokens) of the
+    models in use so the episode reports its own share; ``observers`` get its events."""
 
     def __init__(
         self,
@@ -144,35 +187,43 @@ class Episode:
         intention: Intention,
         user: User,
         executor: PlanExecutor,
-        env: Any,
+        env: Env,
         config: EpisodeConfig | None = None,
-        out_dir: str | Path | None = None,
+        observers: list[Any] | None = None,
         usage: Callable[[], tuple[int, int, int]] | None = None,
-        on_round: Callable[[RoundLog], None] | None = None,
+        model_time: Callable[[], float] | None = None,
         extra_config: dict | None = None,
+        out_dir: str | Path | None = None,
     ):
         self.learner, self.intention, self.user = learner, intention, user
         self.executor, self.env = executor, env
         self.config = config or EpisodeConfig()
-        self.out = Path(out_dir) if out_dir else None
+        self.observers = list(observers or [])
         self.usage = usage or (lambda: (0, 0, 0))
-        self.on_round = on_round
+        self.model_time = model_time or (lambda: 0.0)
         self.extra_config = extra_config or {}
-        self.seeds = EpisodeSeeds.from_seed(self.config.seed)
+        self.out = Path(out_dir) if out_dir else None
+        self.seeds = EpisodeSeeds.from_seed(self.config.seed, self.config.test_seed)
         self.clock = _Clock()
 
-    # -- helpers ---------------------------------------------------------------------------
+    def emit(self, event: str, *args) -> None:
+        for obs in self.observers:
+            handler = getattr(obs, event, None)
+            if handler is not None:
+                handler(*args)
+
+    # -- grounding y ---------------------------------------------------------------------------
     def _plan(self, goal: str, state: WorldState) -> tuple[list[Skill], str | None]:
-        result = self.clock.timed("model_s", self.executor.to_plan, goal, state)
+        result = self.clock.timed("executor_s", self.executor.to_plan, goal, state)
         failure = result.failure.feedback_text() if result.failure else None
         return list(result.plan), failure
 
-    def _estimate_and_ground(self, scene: Scene, state: WorldState, final: bool) -> tuple[Estimate, list[list[Skill]], list[str | None]]:
+    def _ground(self, ask: Callable[[Scene, WorldState], Estimate], scene: Scene, state: WorldState
+                ) -> tuple[Estimate, list[list[Skill]], list[str | None]]:
         """z, y from the learner and y turned into plans; y that cannot be grounded is sent back
-        to the learner ("I failed to generate the goal…") up to max_goal_retries times."""
-        ask = self.learner.final if final else self.learner.estimate
+        ("I failed to generate the goal…") up to max_goal_retries times."""
         for attempt in range(self.config.max_goal_retries + 1):
-            est = self.clock.timed("model_s", ask, scene, state)
+            est = self.clock.timed("learner_s", ask, scene, state)
             if est.plans is not None:
                 return est, [list(p) for p in est.plans], [None] * len(est.plans)
             plans, failures = [], []
@@ -187,185 +238,175 @@ class Episode:
                 self.learner.execution_failed(goal, failure or "")
         raise AssertionError("unreachable")
 
-    def _execute(self, scene: Scene, layout_seed: int, plan: list[Skill]) -> Trajectory:
-        self.clock.timed("sim_s", self.env.reset, scene, layout_seed)
-        return self.clock.timed("sim_s", self.env.execute, plan)
-
     def _video(self, traj: Trajectory, name: str) -> None:
-        if self.out is not None and self.config.save_videos:
-            from activeintent.sim.video import export_video
+        if self.out is None or not self.env.renders or traj.renderer is None:
+            return
+        from activeintent.sim.video import export_video  # only envs that render reach here
 
-            self.clock.timed("render_s", export_video, traj, self.out / f"{name}.gif", fps=self.config.video_fps)
+        self.clock.timed("video_s", export_video, traj, self.out / f"{name}.gif", fps=self.config.video_fps)
 
-    def _test_scenes(self, shown: set[frozenset[str]]) -> list[Scene]:
+    # -- scoring -------------------------------------------------------------------------------
+    def _test_set(self) -> list[tuple[Scene, int]]:
         rng = np.random.default_rng(self.seeds.test)
-        scenes: list[Scene] = []
-        for _ in range(self.config.test_scenes):
-            for _try in range(50):
-                scene = self.intention.sample_scene(rng)
-                if frozenset(scene.objects) not in shown:
-                    break
-            scenes.append(scene)
-        return scenes
+        return [(sample_test_scene(rng), int(rng.integers(2**31))) for _ in range(self.config.test_scenes)]
 
-    # -- the loop --------------------------------------------------------------------------
+    def _score(self, k: int, tests: list[tuple[Scene, int]], physics: bool) -> tuple[float | None, list[TestLog]]:
+        """The learner's current answer on every test scene; success over the feasible ones."""
+        logs = []
+        for i, (scene, seed) in enumerate(tests):
+            state = WorldState(positions=layout(scene, seed))
+            est, plans, failures = self._ground(self.learner.final, scene, state)
+            plan = plans[0] if plans else []
+            states, _ = self.clock.timed("scoring_s", apply_plan, state, plan)
+            end = states[-1] if states else state
+            feasible = bool(self.intention.feasible(scene))  # only now, after the learner answered
+            log = TestLog(scene=list(scene.objects), layout_seed=seed, z=est.z, goal=est.goals[0] if est.goals else "",
+                          plan=describe_plan(plan), failure=failures[0] if failures else None, feasible=feasible,
+                          success=bool(self.clock.timed("scoring_s", self.intention.satisfied, end)))
+            if physics:
+                self.clock.timed("env_s", self.env.reset, scene, seed)
+                traj = self.clock.timed("env_s", self.env.execute, plan)
+                log.success_physics = bool(self.clock.timed("scoring_s", self.intention.satisfied, traj.outcome))
+                log.failure = log.failure or ("; ".join(s.reason or "" for s in traj.failures) or None)
+                if i == 0 and self.config.video != "none":
+                    self._video(traj, "final")
+            logs.append(log)
+        self.learner.drain_transcript()  # scoring calls are not part of any round's record
+        scored = [t.success for t in logs if t.feasible]
+        rate = float(np.mean(scored)) if scored else None
+        self.emit("scored", k, rate)
+        return rate, logs
+
+    # -- the loop ------------------------------------------------------------------------------
     def run(self) -> EpisodeResult:
         start = time.perf_counter()
-        calls0 = self.usage()
+        calls0, model0 = self.usage(), self.model_time()
         cfg = self.config
-        if self.out is not None:
-            self.out.mkdir(parents=True, exist_ok=True)
-            (self.out / "rounds.jsonl").write_text("")
+        self.emit("started", self)
         scene_rng = np.random.default_rng(self.seeds.scenes)
         layout_rng = np.random.default_rng(self.seeds.layouts)
         learner_rng = np.random.default_rng(self.seeds.learner)
+        tests = self._test_set()
         logs: list[RoundLog] = []
-        shown: set[frozenset[str]] = set()
-        signals = new_scenes = 0
+        success_at: list[float | None] = []
+        test_logs: list[TestLog] = []
+        signals = free_new = 0
+        done_at = None
         error = None
         after_new_scene = False
-        # The test scenes are fixed up front (seeded) so per-round progress is measured on them.
-        test_scenes = self._test_scenes(set())
+        physics = self.env.name != "symbolic"
         try:
-            while signals < cfg.rounds:
-                log = self._round(len(logs), scene_rng, layout_rng, learner_rng, test_scenes[0], after_new_scene)
-                logs.append(log)
-                shown.add(frozenset(log.scene))
-                after_new_scene = bool(log.feedback.get("new_scene")) or log.feedback.get("choice") == "new_scene"
-                new_scenes += after_new_scene
-                # New-scene answers are free up to max_new_scenes; past that they use the budget.
-                if not after_new_scene or new_scenes > cfg.max_new_scenes:
-                    signals += 1
+            rate, test_logs = self._score(0, tests, physics and cfg.budget == 0)
+            success_at.append(rate)
+            while self.learner.asks and signals < cfg.budget:
+                log = self._round(len(logs), scene_rng, layout_rng, learner_rng, after_new_scene)
+                after_new_scene = log.answer.get("new_scene", False)
+                free = after_new_scene and cfg.new_scene == "free" and free_new < FREE_NEW_SCENES
+                free_new += free
+                log.counted = not free
+                signals += log.counted
                 log.signals_used = signals
-                self._log_round(log)
-                if log.done:
+                logs.append(log)
+                self.emit("answered", log)
+                if log.done and done_at is None:
+                    done_at = signals
+                if log.counted and (cfg.curve or signals == cfg.budget):
+                    rate, test_logs = self._score(signals, tests, physics and signals == cfg.budget)
+                    success_at.append(rate)
+                elif log.counted:
+                    success_at.append(None)
+                if log.done and cfg.stop_when_done and self.learner.may_finish:
                     break
+            if not self.learner.asks or signals < cfg.budget:
+                # No more signals come (zero-signal baseline, or the learner finished): its answer
+                # stands for the rest of the budget.
+                if physics and (not self.learner.asks or signals > 0):
+                    rate, test_logs = self._score(signals, tests, True)
+                success_at += [rate] * (cfg.budget + 1 - len(success_at))
         except ModelError as err:
-            error = f"model error in round {len(logs) + 1}: {err}"
-        tests: list[TestLog] = []
-        if error is None:
-            test_scenes = [s if frozenset(s.objects) not in shown else None for s in test_scenes]
-            fresh = iter(self._test_scenes(shown))
-            try:
-                for i, scene in enumerate(test_scenes):
-                    tests.append(self._final_test(i, scene or next(fresh)))
-            except ModelError as err:
-                error = f"model error in the final test: {err}"
+            error = f"model error after {signals} signals: {err}"
+            success_at += [None] * (cfg.budget + 1 - len(success_at))
         calls1 = self.usage()
-        success_rate = float(np.mean([t.success for t in tests])) if tests else 0.0
+        physics_scored = [t for t in test_logs if t.feasible and t.success_physics is not None]
+        split = {k: round(v, 3) for k, v in self.clock.split.items()}
+        split["model_s"] = round(self.model_time() - model0, 3)  # inside learner_s / executor_s
         result = EpisodeResult(
             method=self.learner.name,
             intention=self.intention.name,
             seed=cfg.seed,
-            success=bool(tests) and all(t.success for t in tests),
-            success_rate=success_rate,
-            rounds_used=len(logs),
+            test_seed=self.seeds.test,
+            env=self.env.name,
+            budget=cfg.budget,
+            new_scene=cfg.new_scene,
+            success=success_at[-1] if error is None else None,
+            success_at=success_at,
+            success_physics=float(np.mean([t.success_physics for t in physics_scored])) if physics_scored else None,
+            physics_disagreements=sum(t.success != t.success_physics for t in physics_scored) if physics_scored else None,
+            test_scenes=len(tests),
+            test_excluded=sum(not t.feasible for t in test_logs),
             signals_used=signals,
-            final_preference=tests[0].preference if tests else "",
-            final_goal=tests[0].goal if tests else "",
+            answers=dict(Counter(answer_kind_from_dump(log.answer) for log in logs)),
+            rounds_used=len(logs),
+            done_at=done_at,
+            final_z=test_logs[0].z if test_logs else "",
+            final_goal=test_logs[0].goal if test_logs else "",
             retriever=self.learner.retriever,
             llm_calls=calls1[0] - calls0[0],
             prompt_tokens=calls1[1] - calls0[1],
             completion_tokens=calls1[2] - calls0[2],
             wall_s=round(time.perf_counter() - start, 3),
-            time_split={k: round(v, 3) for k, v in self.clock.split.items()},
-            per_round_success=[log.progress_success for log in logs if log.progress_success is not None],
-            tests=tests,
+            time_split=split,
+            tests=test_logs,
             learner_stats=self.learner.stats(),
+            user=getattr(self.user, "parameters", lambda: {})(),
             error=error,
             config={"episode": cfg.model_dump(), **self.extra_config},
         )
-        if self.out is not None:
-            (self.out / "summary.json").write_text(result.model_dump_json(indent=2))
+        self.emit("finished", result)
         return result
 
-    def _round(self, index: int, scene_rng, layout_rng, learner_rng, test_scene: Scene, after_new_scene: bool) -> RoundLog:
+    def _round(self, index: int, scene_rng, layout_rng, learner_rng, after_new_scene: bool) -> RoundLog:
         t0 = dict(self.clock.split)
         scene, source = None, "learner"
         if after_new_scene:
             source = "sampled (the user asked for a new scene)"
         else:
-            scene = self.clock.timed("model_s", self.learner.design_scene, learner_rng)
+            scene = self.clock.timed("learner_s", self.learner.design_scene, learner_rng)
             if scene is None:
                 source = "sampled (the learner designs no scenes, or its choice was unusable)"
         if scene is None:
-            # Two or three blocks and two bowls, bowls matching blocks' colours where possible:
-            # such scenes can show most intentions, without knowing which one is hidden.
-            scene = sample_scene(scene_rng, n_blocks=(2, 3), n_bowls=2, matching=True)
+            scene = sample_round_scene(scene_rng)
         layout_seed = int(layout_rng.integers(2**31))
-        state = self.clock.timed("sim_s", self.env.reset, scene, layout_seed)
-        est, plans, failures = self._estimate_and_ground(scene, state, final=False)
+        state = self.clock.timed("env_s", self.env.reset, scene, layout_seed)
+        est, plans, failures = self._ground(self.learner.estimate, scene, state)
+        labels = ["A", "B"] if len(plans) == 2 else ["y"] * len(plans)
         trajectories = []
         for i, plan in enumerate(plans):
-            traj = self._execute(scene, layout_seed, plan)
+            self.clock.timed("env_s", self.env.reset, scene, layout_seed)
+            traj = self.clock.timed("env_s", self.env.execute, plan)
             trajectories.append(traj)
             failures[i] = failures[i] or ("; ".join(s.reason or "" for s in traj.failures) or None)
-            self._video(traj, f"round{index + 1}_{'ab'[i] if len(plans) > 1 else 'y'}")
-        h = self.user.respond(scene, trajectories)
-        record = RoundRecord(index=index, scene=scene, estimate=est, plans=plans, failures=failures, feedback=h)
-        r = self.clock.timed("model_s", self.learner.observe, record, trajectories)
-        calls = self.learner.drain_transcript()
-        progress = None
-        if self.config.track_progress:
-            progress = self._probe(test_scene)
-            calls += [dict(c, probe=True) for c in self.learner.drain_transcript()]
-        log = RoundLog(
-            round=index + 1,
-            scene=list(scene.objects),
-            scene_source=source,
-            layout_seed=layout_seed,
-            preference=est.preference,
-            goals=est.goals,
-            plans=[describe_plan(p) for p in plans],
-            failures=failures,
-            feedback=h.model_dump(),
-            retrieved=r,
-            retriever=self.learner.retriever,
-            done=est.done,
-            progress_success=progress,
-            calls=calls,
+            if self.config.video == "all":
+                self._video(traj, f"round{index + 1}_{labels[i]}")
+        self.emit("shown", index, scene, est, trajectories)
+        h = self.clock.timed("user_s", self.user.respond, scene, trajectories)
+        record = RoundRecord(index=index, scene=scene, estimate=est, plans=plans, failures=failures, answer=h)
+        r = self.clock.timed("learner_s", self.learner.observe, record, trajectories)
+        return RoundLog(
+            round=index + 1, scene=list(scene.objects), scene_source=source, layout_seed=layout_seed,
+            z=est.z, goals=est.goals, labels=labels, plans=[describe_plan(p) for p in plans], failures=failures,
+            executed=[t.moved_anything for t in trajectories], answer=h.model_dump(mode="json"), counted=True,
+            signals_used=0, retrieved=r, retriever=self.learner.retriever, done=est.done, why=est.why,
+            calls=self.learner.drain_transcript(),
             timing={k: round(v - t0[k], 4) for k, v in self.clock.split.items()},
         )
-        return log
-
-    def _log_round(self, log: RoundLog) -> None:
-        if self.out is not None:
-            with (self.out / "rounds.jsonl").open("a") as f:
-                f.write(log.model_dump_json() + "\n")
-        if self.on_round:
-            self.on_round(log)
-
-    def _probe(self, scene: Scene) -> float:
-        """Success of the current estimate on the first test scene, predicted symbolically."""
-        from activeintent.world import layout
-
-        state = WorldState(positions=layout(scene, self.seeds.test))
-        try:
-            est = self.clock.timed("model_s", self.learner.final, scene, state)
-        except ModelError:
-            return 0.0
-        plan = est.plans[0] if est.plans else self._plan(est.goals[0], state)[0]
-        states, _ = apply_plan(state, plan)
-        return float(self.intention.satisfied(states[-1] if states else state))
-
-    def _final_test(self, index: int, scene: Scene) -> TestLog:
-        layout_seed = self.seeds.test + index
-        state = self.clock.timed("sim_s", self.env.reset, scene, layout_seed)
-        est, plans, failures = self._estimate_and_ground(scene, state, final=True)
-        traj = self._execute(scene, layout_seed, plans[0])
-        self._video(traj, f"final{index + 1}" if self.config.test_scenes > 1 else "final")
-        final_state = traj.final_state or state
-        return TestLog(
-            calls=self.learner.drain_transcript(),
-            scene=list(scene.objects),
-            preference=est.preference,
-            goal=est.goals[0],
-            plan=describe_plan(plans[0]),
-            failure=failures[0] or ("; ".join(s.reason or "" for s in traj.failures) or None),
-            success=bool(self.intention.satisfied(final_state)),
-            score=float(self.intention.score(final_state)),
-        )
 
 
-def read_rounds(path: str | Path) -> list[dict]:
-    return [json.loads(line) for line in Path(path).read_text().splitlines() if line.strip()]
+def answer_kind_from_dump(d: dict) -> str:
+    if d.get("new_scene"):
+        return "new_scene"
+    if "choice" in d:
+        return str(d["choice"])
+    if "stop_time" in d:
+        return "no_stop" if d["stop_time"] is None else "stop"
+    return str(d.get("signal"))

@@ -1,36 +1,51 @@
-"""Command-line options shared by `run`, `bench` and `serve` (typer annotations)."""
+"""Command-line options shared by `run`, `bench` and `serve`: declared once here, defaults
+read from :class:`activeintent.runner.RunOptions` (``D``), so nothing is typed twice."""
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from activeintent.runner import UserOptions
+from activeintent.runner import RunOptions
 
-Llm = Annotated[str, typer.Option("--llm", help="LLM spec: embedded | gguf:/path.gguf | openai:<model> | none (Bayesian methods only)")]
+D = RunOptions()  # the defaults
+
+Method = Annotated[str, typer.Option("--method", help="Learner (see `activeintent methods`)")]
+Intention = Annotated[str | None, typer.Option("--intention", help="Hidden intention (see `activeintent intentions`)")]
+IntentionFile = Annotated[str | None, typer.Option("--intention-file", help="Your own intention: path.py:NAME")]
+Plugin = Annotated[list[str] | None, typer.Option("--plugin", help="Python file registering signals, methods, envs… (repeatable)")]
+Budget = Annotated[int, typer.Option("--budget", min=0, max=100, help="K: signals the user gives; every answer counts")]
+Seed = Annotated[int, typer.Option("--seed", min=0, help="Seed of every random choice")]
+TestScenes = Annotated[int, typer.Option("--test-scenes", min=1, max=200, help="Test scenes scored after every signal")]
+Env = Annotated[str, typer.Option("--env", help="Where plans run: pybullet | symbolic")]
+User = Annotated[str, typer.Option("--user", help="Simulated-user preset: human | paper | exact (see docs/protocol.md)")]
+NewScene = Annotated[str, typer.Option("--new-scene", help="counted (every answer is a signal) | free (old rule, ≤3 uncounted) | off")]
+Prior = Annotated[str, typer.Option("--prior", help="Bayesian prior: length (description length) | uniform")]
+Llm = Annotated[str, typer.Option("--llm", help="LLM: embedded | gguf:/path.gguf | openai:<model> | none (Bayesian methods and baselines)")]
 Vlm = Annotated[str | None, typer.Option("--vlm", help="Multimodal model spec for the retriever (default: the LLM)")]
 BaseUrl = Annotated[str | None, typer.Option("--base-url", envvar="OPENAI_BASE_URL", help="OpenAI-compatible endpoint")]
 Cache = Annotated[str | None, typer.Option("--cache", help="Response cache file (SQLite); default ~/.cache/activeintent")]
 CacheMode = Annotated[str, typer.Option("--cache-mode", help="record | replay | off")]
 Executor = Annotated[str, typer.Option("--executor", help="y → plan: parse | plan | cap")]
 Retriever = Annotated[str, typer.Option("--retriever", help="r from a stop: symbolic | vision")]
-Intention = Annotated[str | None, typer.Option("--intention", help="Hidden intention (see `activeintent intentions`)")]
-IntentionFile = Annotated[str | None, typer.Option("--intention-file", help="Your own intention: path.py:NAME")]
-Rounds = Annotated[int, typer.Option("--rounds", min=1, help="K: feedback signals per episode")]
-Seed = Annotated[int, typer.Option("--seed", help="Seed of every random choice")]
-UserBeta = Annotated[float, typer.Option("--user-beta", help="Preference-user rationality β (inf = exact user)")]
-ReactionDelay = Annotated[str, typer.Option("--reaction-delay", help="Stop-user reaction delay MEAN,SD in seconds")]
-FalseStop = Annotated[float, typer.Option("--false-stop", min=0.0, max=1.0, help="P(stop although nothing is wrong)")]
-MissedStop = Annotated[float, typer.Option("--missed-stop", min=0.0, max=1.0, help="P(no stop although something is wrong)")]
+Epsilon = Annotated[float, typer.Option("--epsilon", min=0.0, help="ε: seconds before the stop for image I_b")]
+Video = Annotated[str, typer.Option("--video", help="GIFs written: none | final | all")]
+Out = Annotated[Path | None, typer.Option("--out", help="Output folder")]
 
 
-def user_options(beta: float, reaction_delay: str, false_stop: float, missed_stop: float) -> UserOptions:
+def run_options(**values) -> RunOptions:
+    """RunOptions from CLI values; a bad value becomes a message naming the option."""
+    from pydantic import ValidationError
+
+    values = {k: v for k, v in values.items() if v is not None or k in ("intention", "intention_file", "vlm")}
+    values["plugins"] = list(values.get("plugins") or [])
     try:
-        mean, sd = (float(v) for v in reaction_delay.split(","))
-    except ValueError:
-        raise typer.BadParameter(f"--reaction-delay takes MEAN,SD in seconds, e.g. 0.5,0.15; got {reaction_delay!r}") from None
-    if mean < 0 or sd < 0:
-        raise typer.BadParameter("--reaction-delay MEAN and SD must be ≥ 0")
-    return UserOptions(beta=beta, reaction_delay_mean=mean, reaction_delay_sd=sd,
-                       false_stop=false_stop, missed_stop=missed_stop)
+        return RunOptions(**values)
+    except ValidationError as err:
+        msgs = []
+        for e in err.errors():
+            name = "--" + str(e["loc"][0]).replace("_", "-")
+            msgs.append(f"{name}: {e['msg']} (got {e.get('input')!r})")
+        raise ValueError("; ".join(msgs)) from None

@@ -1,51 +1,53 @@
-"""Wiring one episode from options: models, learner, executor, simulator, user.
+"""Wiring one episode from options: models, learner, executor, env, user.
 
-`activeintent run`, `activeintent bench` and the web app all build episodes here, so a run
-means the same thing everywhere.
+`activeintent run`, `activeintent bench`, `activeintent serve` and the Python API all build
+episodes here, so a run means the same thing everywhere. :class:`RunOptions` holds every
+option with its default, typed once; the CLI reads its defaults from here.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, ConfigDict, Field
 
-from activeintent.episode import Episode, EpisodeConfig, EpisodeSeeds, RoundLog
+from activeintent.episode import Episode, EpisodeConfig, EpisodeSeeds
+from activeintent.protocol import DEFAULT_BUDGET, DEFAULT_TEST_SCENES, NewSceneRule
 
-DEFAULT_METHOD = "bayes-stop"  # beats the paper's methods in the benchmark (README, Results)
+DEFAULT_METHOD = "bayes-stop"
 DEFAULT_INTENTION = "color-match"
 
 
-class UserOptions(BaseModel):
-    """Simulated-user parameters (recorded in every result)."""
-
-    beta: float = Field(float("inf"), description="rationality β of the preference user; inf = exact")
-    reaction_delay_mean: float = 0.5
-    reaction_delay_sd: float = 0.15
-    false_stop: float = 0.0
-    missed_stop: float = 0.0
-
-
 class RunOptions(BaseModel):
+    """Every option of an episode (the CLI's defaults are these)."""
+
+    model_config = ConfigDict(extra="forbid")
+
     method: str = DEFAULT_METHOD
     intention: str | None = None
     intention_file: str | None = None
-    rounds: int = 5
-    seed: int = 0
-    test_scenes: int = 1
+    plugins: list[str] = Field(default_factory=list, description="Python files that register plug-ins")
+    budget: int = Field(DEFAULT_BUDGET, ge=0, le=100)
+    seed: int = Field(0, ge=0)
+    test_seed: int | None = Field(None, ge=0)
+    test_scenes: int = Field(DEFAULT_TEST_SCENES, ge=1, le=200)
+    env: str = "pybullet"
+    user: str = "human"
+    new_scene: NewSceneRule = "counted"
+    prior: str = Field("length", pattern="^(length|uniform)$")
     llm: str = "embedded"
     vlm: str | None = None
     base_url: str | None = None
     cache: str | None = None
-    cache_mode: str = "record"
+    cache_mode: str = Field("record", pattern="^(record|replay|off)$")
     executor: str = "plan"
-    retriever: str = "symbolic"
-    epsilon: float = 2.0
+    retriever: str = Field("symbolic", pattern="^(symbolic|vision)$")
+    epsilon: float = Field(2.0, ge=0)
     design_scenes: bool = True
-    save_videos: bool = True
-    track_progress: bool = False
-    user: UserOptions = Field(default_factory=UserOptions)
+    video: str = Field("final", pattern="^(none|final|all)$")
+    curve: bool = True
+    stop_when_done: bool = False
 
 
 class Models:
@@ -53,77 +55,92 @@ class Models:
 
     def __init__(self, options: RunOptions):
         self.options = options
-        self._llm = None
-        self._vlm = None
+        self._loaded: dict[str, Any] = {}
 
-    def _load(self, spec: str):
-        from activeintent.llm.registry import load_model
-
-        if spec == "none":
+    def _load(self, spec: str | None):
+        if spec is None or spec == "none":
             return None
-        o = self.options
-        return load_model(spec, base_url=o.base_url, cache_path=o.cache, cache_mode=o.cache_mode)
+        if spec not in self._loaded:
+            from activeintent.llm.registry import load_model
+
+            o = self.options
+            self._loaded[spec] = load_model(spec, base_url=o.base_url, cache_path=o.cache, cache_mode=o.cache_mode)
+        return self._loaded[spec]
 
     @property
     def llm(self):
-        if self._llm is None and self.options.llm != "none":
-            self._llm = self._load(self.options.llm)
-        return self._llm
+        return self._load(self.options.llm)
 
     @property
     def vlm(self):
-        if self.options.vlm is None:
-            return None
-        if self._vlm is None:
-            self._vlm = self._load(self.options.vlm)
-        return self._vlm
+        return self._load(self.options.vlm)
+
+    def _totals(self):
+        return [m.usage.snapshot() for m in self._loaded.values() if m is not None and m.usage is not None]
 
     def usage(self) -> tuple[int, int, int]:
-        calls = prompt = completion = 0
-        for m in {id(m): m for m in (self._llm, self._vlm) if m is not None}.values():
-            if m.usage is None:
-                continue
-            totals = m.usage.snapshot()
-            calls += totals.calls
-            prompt += totals.prompt_tokens
-            completion += totals.completion_tokens
-        return calls, prompt, completion
+        t = self._totals()
+        return sum(x.calls for x in t), sum(x.prompt_tokens for x in t), sum(x.completion_tokens for x in t)
+
+    def model_time(self) -> float:
+        return float(sum(x.latency_s for x in self._totals()))
+
+
+def check_options(options: RunOptions) -> None:
+    """Refuse, before any work, options that cannot run; messages name the option and list choices."""
+    from activeintent.envs import ENVS
+    from activeintent.learners.registry import get_method
+    from activeintent.registry import load_plugin
+    from activeintent.users.simulated import USER_PRESETS
+
+    for path in options.plugins:
+        load_plugin(path)
+    method = get_method(options.method)
+    ENVS.check(options.env)
+    USER_PRESETS.check(options.user)
+    if method.needs_llm and options.llm == "none":
+        raise ValueError(f"--method {options.method} needs a language model; --llm none is only for methods "
+                         "that need none (bayes-*, zero-signal, random-query*).")
+    if options.executor not in ("parse", "plan", "cap"):
+        raise ValueError(f"Unknown executor {options.executor!r}; valid executors: parse, plan, cap.")
 
 
 def build_episode(
     options: RunOptions,
-    out_dir: str | Path | None,
+    out_dir: str | Path | None = None,
     user=None,
-    on_round: Callable[[RoundLog], None] | None = None,
+    observers: list | None = None,
     env=None,
 ) -> Episode:
-    """Everything `activeintent run` does before the loop starts. Errors in the options
-    (unknown method, intention, executor, model spec) are raised here, before any work."""
+    """Everything before the loop starts. Errors in the options are raised here, before any work."""
     from activeintent.act.base import make_executor
-    from activeintent.intentions.registry import resolve_intention
-    from activeintent.learners.registry import SIGNAL, check_method, make_learner
-    from activeintent.sim.env import TabletopEnv
-    from activeintent.users.simulated import UserConfig, make_user
+    from activeintent.envs import make_env
+    from activeintent.learners.registry import LearnerContext, get_method
+    from activeintent.records import EpisodeRecorder
+    from activeintent.suites import resolve as resolve_intention
+    from activeintent.users.simulated import SimulatedUser, user_profile
 
-    check_method(options.method)
+    check_options(options)
+    method = get_method(options.method)
     intention = resolve_intention(options.intention or (None if options.intention_file else DEFAULT_INTENTION),
                                   options.intention_file)
     models = Models(options)
-    seeds = EpisodeSeeds.from_seed(options.seed)
-    # Bayesian methods need no model; given one, it proposes open-ended hypotheses.
+    seeds = EpisodeSeeds.from_seed(options.seed, options.test_seed)
     llm = models.llm
-    learner = make_learner(options.method, llm=llm, vlm=models.vlm, retriever=options.retriever,
-                           seed=seeds.learner, design_scenes=options.design_scenes,
-                           epsilon=options.epsilon)
+    learner = method(LearnerContext(llm=llm, vlm=models.vlm, retriever=options.retriever, seed=seeds.learner,
+                                    design_scenes=options.design_scenes, epsilon=options.epsilon,
+                                    prior=options.prior))
     executor = make_executor(options.executor, model=llm)
     if user is None:
-        u = options.user
-        user = make_user(SIGNAL[options.method], intention,
-                         UserConfig(beta=u.beta, reaction_delay_mean=u.reaction_delay_mean,
-                                    reaction_delay_sd=u.reaction_delay_sd, false_stop=u.false_stop,
-                                    missed_stop=u.missed_stop), seed=seeds.user)
-    config = EpisodeConfig(rounds=options.rounds, seed=options.seed, test_scenes=options.test_scenes,
-                           save_videos=options.save_videos, track_progress=options.track_progress)
-    return Episode(learner, intention, user, executor, env or TabletopEnv(), config, out_dir,
-                   usage=models.usage, on_round=on_round,
-                   extra_config={"options": options.model_dump(mode="json")})
+        user = SimulatedUser(intention, method.signal, user_profile(options.user), rng=seeds.user)
+        if options.new_scene == "off":
+            user.profile = user.profile.model_copy(update={"new_scene_false": 0.0, "new_scene_miss": 1.0})
+    config = EpisodeConfig(budget=options.budget, seed=options.seed, test_seed=options.test_seed,
+                           test_scenes=options.test_scenes, new_scene=options.new_scene, curve=options.curve,
+                           video=options.video, stop_when_done=options.stop_when_done)
+    observers = list(observers or [])
+    if out_dir is not None:
+        observers.insert(0, EpisodeRecorder(out_dir))
+    return Episode(learner, intention, user, executor, env or make_env(options.env), config, observers,
+                   usage=models.usage, model_time=models.model_time,
+                   extra_config={"options": options.model_dump(mode="json")}, out_dir=out_dir)

@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from activeintent import options as opt
+from activeintent.options import D
 
 
 def register(app: typer.Typer) -> None:
@@ -19,29 +20,34 @@ def _split(text: str) -> list[str]:
 
 
 def bench(
-    methods: Annotated[str, typer.Option("--methods", help="Comma-separated methods (default: all)")] = "",
-    intentions: Annotated[str, typer.Option("--intentions", help="Comma-separated intentions")] = "align,stack,color-match,color-mismatch",
+    methods: Annotated[str, typer.Option("--methods", help="Comma-separated methods (default: bayes-preference, bayes-stop and the baselines)")] = "",
+    suite: Annotated[str, typer.Option("--suite", help="Comma-separated suites: paper, library, heldout")] = "paper",
+    intentions: Annotated[str, typer.Option("--intentions", help="Comma-separated intentions (instead of --suite)")] = "",
     intention_file: Annotated[list[str] | None, typer.Option("--intention-file", help="Add your own: path.py:NAME (repeatable)")] = None,
-    trials: Annotated[int, typer.Option("--trials", min=1)] = 5,
-    rounds: opt.Rounds = 5,
-    seed: opt.Seed = 0,
-    llm: opt.Llm = "embedded",
+    plugin: opt.Plugin = None,
+    trials: Annotated[int, typer.Option("--trials", min=1, help="Episodes per method and intention")] = 20,
+    budget: opt.Budget = D.budget,
+    seed: opt.Seed = D.seed,
+    test_scenes: opt.TestScenes = D.test_scenes,
+    env: opt.Env = D.env,
+    user: opt.User = D.user,
+    new_scene: opt.NewScene = D.new_scene,
+    prior: opt.Prior = D.prior,
+    llm: opt.Llm = D.llm,
     vlm: opt.Vlm = None,
     base_url: opt.BaseUrl = None,
     cache: opt.Cache = None,
-    cache_mode: opt.CacheMode = "record",
-    executor: opt.Executor = "plan",
-    retriever: opt.Retriever = "symbolic",
-    user_beta: opt.UserBeta = float("inf"),
-    reaction_delay: opt.ReactionDelay = "0.5,0.15",
-    false_stop: opt.FalseStop = 0.0,
-    missed_stop: opt.MissedStop = 0.0,
+    cache_mode: opt.CacheMode = D.cache_mode,
+    executor: opt.Executor = D.executor,
+    retriever: opt.Retriever = D.retriever,
+    curve: Annotated[bool, typer.Option(help="Score after every signal (off: only k = 0 and K; for slow models)")] = True,
     jobs: Annotated[int, typer.Option("--jobs", min=1, help="Episodes run in parallel (processes)")] = 1,
-    videos: Annotated[bool, typer.Option(help="Save a GIF per executed trajectory")] = False,
+    keep_episodes: Annotated[bool, typer.Option(help="Keep each episode's rounds.jsonl and summary.json")] = False,
     retry_errors: Annotated[bool, typer.Option(help="Re-run episodes that ended in an error")] = False,
     out: Annotated[Path, typer.Option("--out", help="Results folder; re-running with it resumes")] = Path("runs/bench"),
 ) -> None:
-    """Compare methods on identical work; writes results.jsonl, report.md, success_vs_rounds.png."""
+    """Compare methods on identical work under the honest protocol; writes results.jsonl,
+    report.md and success_vs_signals.png."""
     from rich.console import Console
     from rich.progress import (
         BarColumn,
@@ -52,39 +58,45 @@ def bench(
         TimeRemainingColumn,
     )
 
-    from activeintent.bench.report import plot_success_vs_rounds, write_report
-    from activeintent.bench.runner import BenchOptions, run_bench
-    from activeintent.intentions.registry import resolve_intention
-    from activeintent.learners.registry import METHODS, check_method
-    from activeintent.runner import RunOptions
+    from activeintent.bench.report import plot_success_vs_signals, write_report
+    from activeintent.bench.runner import BenchOptions, protocol_fields, run_bench
+    from activeintent.runner import check_options
+    from activeintent.suites import resolve, suite
 
     console = Console()
     try:
-        method_list = [check_method(m) for m in (_split(methods) or list(METHODS))]
-        intention_list = _split(intentions)
+        run = opt.run_options(plugins=plugin, budget=budget, test_scenes=test_scenes, env=env, user=user,
+                              new_scene=new_scene, prior=prior, llm=llm, vlm=vlm, base_url=base_url, cache=cache,
+                              cache_mode=cache_mode, executor=executor, retriever=retriever, curve=curve, video="none")
+        method_list = _split(methods) or ["bayes-preference", "bayes-stop", "zero-signal", "random-query"]
+        for m in method_list:
+            check_options(run.model_copy(update={"method": m}))
+        intention_list = _split(intentions) or [i for s in _split(suite) for i in suite(s)]
         for name in intention_list:
-            resolve_intention(name, None)
+            resolve(name)
         for f in intention_file or []:
-            resolve_intention(None, f)
+            resolve(None, f)
+        if not intention_list and not intention_file:
+            raise ValueError("no intentions to run: give --suite, --intentions or --intention-file")
     except (ValueError, FileNotFoundError) as err:
         console.print(f"[red]error:[/red] {err}")
         raise typer.Exit(2) from None
-    run = RunOptions(rounds=rounds, llm=llm, vlm=vlm, base_url=base_url, cache=cache, cache_mode=cache_mode,
-                     executor=executor, retriever=retriever, save_videos=videos,
-                     user=opt.user_options(user_beta, reaction_delay, false_stop, missed_stop))
     options = BenchOptions(methods=method_list, intentions=intention_list, intention_files=list(intention_file or []),
-                           trials=trials, seed=seed, jobs=jobs, retry_errors=retry_errors, run=run)
+                           trials=trials, seed=seed, jobs=jobs, retry_errors=retry_errors,
+                           keep_episodes=keep_episodes, run=run)
     progress = Progress(TextColumn("[bold]bench"), BarColumn(), MofNCompleteColumn(), TextColumn("episodes"),
                         TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(), TextColumn("{task.description}"),
-                        console=console)
+                        console=console, transient=not console.is_terminal)
     with progress:
         task = progress.add_task("", total=len(options.items()))
 
         def on_done(record: dict, finished: int, total: int) -> None:
             if record:
-                mark = "[red]error[/red]" if record.get("error") else ("✓" if record.get("success") else "✗")
-                progress.console.print(f"{mark} {record['method']} · {record['intention']} · trial {record['trial']}"
-                                       + (f" — {record['error']}" if record.get("error") else ""))
+                s = record.get("success")
+                mark = "[red]error[/red]" if record.get("error") else ("–" if s is None else f"{s:.2f}")
+                if console.is_terminal or record.get("error"):
+                    progress.console.print(f"{mark} {record['method']} · {record['intention']} · trial {record['trial']}"
+                                           + (f" — {record['error']}" if record.get("error") else ""))
                 progress.update(task, completed=finished, description=f"last: {record['method']}/{record['intention']}")
             else:
                 progress.update(task, completed=finished)
@@ -95,12 +107,9 @@ def bench(
             progress.stop()
             console.print(f"[red]error:[/red] {err}")
             raise typer.Exit(2) from None
+    settings = {**protocol_fields(run), "trials": trials, "seed": seed}
     all_intentions = intention_list + list(intention_file or [])
-    settings = {"trials": trials, "rounds": rounds, "llm": llm, "vlm": vlm or llm, "executor": executor,
-                "retriever": retriever, "user": run.user.model_dump(), "seed": seed}
-    from activeintent.bench.extras import extra_sections
-
-    report = write_report(records, method_list, all_intentions, out, settings, extra_sections(records, method_list))
-    plot_success_vs_rounds(records, method_list, rounds, out)
-    console.print(report.read_text())
-    console.print(f"[bold]report:[/bold] {report}  [bold]plot:[/bold] {out / 'success_vs_rounds.png'}")
+    report = write_report(records, method_list, all_intentions, out, settings)
+    plot_success_vs_signals(records, method_list, budget, out)
+    console.print(report.read_text(), markup=False)
+    console.print(f"report: {out / 'report.md'}  plot: {out / 'success_vs_signals.png'}", markup=False)

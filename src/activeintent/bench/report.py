@@ -1,4 +1,5 @@
-"""report.md (the paper's Table 1 layout, ours beside the paper's) and success_vs_rounds.png."""
+"""report.md and success_vs_signals.png: every rate with its episode count and a 95 % Wilson
+interval, per suite, baselines beside the methods, the protocol stated on top."""
 
 from __future__ import annotations
 
@@ -8,132 +9,141 @@ from pathlib import Path
 
 import numpy as np
 
-# The paper's Table 1 (gpt-4-1106-preview as LLM, gpt-4-vision-preview as MLLM; 5 trials each).
+from activeintent.suites import suite_of
+
+# The paper's Table 1: success judged by people, 5 trials each. Models per the paper's text:
+# the preference method used the LLM (GPT-4); mllm used GPT-4V alone; mllm-llm GPT-4V + GPT-4.
 PAPER_TABLE1 = {
-    "preference": {"align": 0.6, "stack": 0.0, "color-match": 0.6, "color-mismatch": 0.4},
-    "mllm": {"align": 0.4, "stack": 0.2, "color-match": 0.8, "color-mismatch": 0.4},
-    "mllm-llm": {"align": 0.6, "stack": 0.4, "color-match": 0.8, "color-mismatch": 0.6},
+    "preference": ({"align": 0.6, "stack": 0.0, "color-match": 0.6, "color-mismatch": 0.4}, "GPT-4"),
+    "mllm": ({"align": 0.4, "stack": 0.2, "color-match": 0.8, "color-mismatch": 0.4}, "GPT-4V"),
+    "mllm-llm": ({"align": 0.6, "stack": 0.4, "color-match": 0.8, "color-mismatch": 0.6}, "GPT-4V + GPT-4"),
 }
-PAPER_MODELS = "gpt-4-1106-preview (LLM) + gpt-4-vision-preview (MLLM), human judges"
+BASELINES = ("zero-signal", "random-query", "random-query-preference")
 
 
 def wilson(successes: float, n: int, z: float = 1.96) -> tuple[float, float]:
-    """95% Wilson score interval of a binomial proportion."""
+    """95 % Wilson score interval of a proportion (successes may be fractional: mean × n)."""
     if n == 0:
         return (0.0, 1.0)
     p = successes / n
     denom = 1 + z * z / n
     centre = (p + z * z / (2 * n)) / denom
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    half = z * math.sqrt(max(p * (1 - p) / n + z * z / (4 * n * n), 0.0)) / denom
     return (max(0.0, centre - half), min(1.0, centre + half))
+
+
+def rate(values: list[float]) -> str:
+    if not values:
+        return "–"
+    lo, hi = wilson(sum(values), len(values))
+    return f"{np.mean(values):.2f} [{lo:.2f}, {hi:.2f}] (n={len(values)})"
+
+
+def _ok(r: dict) -> bool:
+    return not r.get("error") and r.get("success") is not None
 
 
 def _short(intention: str) -> str:
     return intention.rsplit(":", 1)[-1] if ".py:" in intention else intention
 
 
-def summarize(records: list[dict], methods: list[str], intentions: list[str]) -> dict:
+def write_report(records: list[dict], methods: list[str], intentions: list[str], out: Path, settings: dict) -> Path:
     by = defaultdict(list)
     for r in records:
         by[(r["method"], r["intention"])].append(r)
-    table = {}
-    for m in methods:
-        row = {}
-        for i in intentions:
-            recs = by.get((m, i), [])
-            rates = [float(r.get("success_rate", float(r.get("success", False)))) for r in recs]
-            row[i] = {"n": len(recs), "rate": float(np.mean(rates)) if rates else None,
-                      "ci": wilson(sum(rates), len(rates)) if rates else None}
-        every = [r for i in intentions for r in by.get((m, i), [])]
-        rates = [float(r.get("success_rate", float(r.get("success", False)))) for r in every]
-        table[m] = {
-            "cells": row,
-            "avg": float(np.mean(rates)) if rates else None,
-            "avg_ci": wilson(sum(rates), len(rates)) if rates else None,
-            "n": len(every),
-            "errors": sum(1 for r in every if r.get("error")),
-            "signals": float(np.mean([r.get("signals_used", 0) for r in every])) if every else None,
-            "tokens": float(np.mean([r.get("prompt_tokens", 0) + r.get("completion_tokens", 0) for r in every])) if every else None,
-            "wall_s": float(np.mean([r.get("wall_s", 0.0) for r in every])) if every else None,
-            "retrievers": sorted({str(r.get("retriever")) for r in every if r.get("retriever")}),
-        }
-    return table
-
-
-def _cell(c: dict) -> str:
-    if c["rate"] is None:
-        return "–"
-    lo, hi = c["ci"]
-    return f"{c['rate']:.2f} [{lo:.2f}, {hi:.2f}]"
-
-
-def write_report(records: list[dict], methods: list[str], intentions: list[str], out: Path,
-                 settings: dict, extra_sections: list[str] | None = None) -> Path:
-    table = summarize(records, methods, intentions)
-    names = [_short(i) for i in intentions]
+    budget = settings.get("budget")
     lines = ["# activeintent benchmark", ""]
-    lines.append("Success rate of the final execution on a fresh scene (95% Wilson interval), "
-                 "per hidden intention. Every method sees the same seeds, scenes and user noise in trial t.")
-    lines.append("")
-    lines.append("Settings: " + ", ".join(f"{k} = `{v}`" for k, v in settings.items()))
-    lines += ["", "## Ours", ""]
-    head = "| method | " + " | ".join(names) + " | average | episodes | signals used | tokens / episode | wall s / episode | retriever |"
-    lines += [head, "|" + "---|" * (len(names) + 7)]
+    lines.append(
+        f"success@{budget}: after exactly {budget} signals (every answer counts, \"new scene\" included "
+        f"unless the protocol says otherwise) the learner's answer acts on each episode's test scenes; an "
+        "episode's success is the share of its test scenes (those where the hidden intention can be "
+        "satisfied) that end satisfied. Cells: mean over episodes [95 % Wilson interval] (n = episodes). "
+        "Test scenes are drawn independently of the hidden intention and are the same for every method "
+        "and intention of a trial.")
+    lines += ["", "Protocol: " + ", ".join(f"{k} = `{v}`" for k, v in settings.items()), ""]
+    if settings.get("env") == "symbolic":
+        lines += ["**Env: symbolic** — outcomes from the symbolic world model, not physics.", ""]
+    suites: dict[str, list[str]] = defaultdict(list)
+    for i in intentions:
+        suites[suite_of(i)].append(i)
+    for suite, names in suites.items():
+        lines += [f"## Suite: {suite}", ""]
+        lines += ["| method | " + " | ".join(_short(i) for i in names) + " | **all** | signals | new-scene answers | test scenes excluded | physics disagreements | errors |",
+                  "|" + "---|" * (len(names) + 7)]
+        for m in methods:
+            every = [r for i in names for r in by.get((m, i), [])]
+            ok = [r for r in every if _ok(r)]
+            cells = [rate([r["success"] for r in by.get((m, i), []) if _ok(r)]) for i in names]
+            signals = np.mean([r.get("signals_used", 0) for r in ok]) if ok else 0
+            new = sum((r.get("answers") or {}).get("new_scene", 0) for r in ok)
+            total = sum(sum((r.get("answers") or {}).values()) for r in ok)
+            excl = np.mean([r.get("test_excluded", 0) for r in ok]) if ok else 0
+            phys = [r for r in ok if r.get("physics_disagreements") is not None]
+            dis = f"{sum(r['physics_disagreements'] for r in phys)} / {len(phys)} ep." if phys else "–"
+            label = f"*{m}* (baseline)" if m in BASELINES else m
+            lines.append(f"| {label} | " + " | ".join(cells) + f" | **{rate([r['success'] for r in ok])}** | "
+                         f"{signals:.1f} | {new}/{total} | {excl:.1f} | {dis} | {len(every) - len(ok)} |")
+        if suite == "paper":
+            cols = [i for i in names if i in PAPER_TABLE1["preference"][0]]
+            lines += ["", "The paper's Table 1 (reference, not ours: people judged success, 5 trials, 5 signals):", "",
+                      "| method (paper) | model | " + " | ".join(cols) + " | average |", "|" + "---|" * (len(cols) + 3)]
+            for m, (row, model) in PAPER_TABLE1.items():
+                lines.append(f"| {m} (paper) | {model} | " + " | ".join(f"{row[i]:.1f}" for i in cols)
+                             + f" | {np.mean(list(row.values())):.2f} |")
+        lines.append("")
+    lines += ["## success@k (all suites pooled)", "", "| method | " + " | ".join(f"k={k}" for k in range((budget or 0) + 1)) + " |",
+              "|" + "---|" * ((budget or 0) + 2)]
     for m in methods:
-        t = table[m]
-        avg = "–" if t["avg"] is None else f"**{t['avg']:.2f}** [{t['avg_ci'][0]:.2f}, {t['avg_ci'][1]:.2f}]"
-        err = f" ({t['errors']} errors)" if t["errors"] else ""
-        lines.append(
-            f"| {m} | " + " | ".join(_cell(t["cells"][i]) for i in intentions)
-            + f" | {avg} | {t['n']}{err} | {t['signals'] or 0:.1f} | {t['tokens'] or 0:.0f} | {t['wall_s'] or 0:.1f} | "
-            + (", ".join(t["retrievers"]) or "–") + " |"
-        )
-    paper_cols = [i for i in intentions if i in PAPER_TABLE1["preference"]]
-    if paper_cols:
-        lines += ["", f"## The paper's Table 1 (reference, not ours: {PAPER_MODELS}; 5 trials, 5 signals)", ""]
-        lines += ["| method (paper) | " + " | ".join(paper_cols) + " | average |", "|" + "---|" * (len(paper_cols) + 2)]
-        for m, row in PAPER_TABLE1.items():
-            lines.append(f"| {m} (paper) | " + " | ".join(f"{row[i]:.1f}" for i in paper_cols)
-                         + f" | {np.mean(list(row.values())):.2f} |")
-    for section in extra_sections or []:
-        lines += ["", section]
-    lines += ["", "![success vs rounds](success_vs_rounds.png)", ""]
+        curves = [r["success_at"] for r in records if r["method"] == m and _ok(r) and r.get("success_at")]
+        cells = []
+        for k in range((budget or 0) + 1):
+            vals = [c[k] for c in curves if k < len(c) and c[k] is not None]
+            cells.append(f"{np.mean(vals):.2f}" if vals else "–")
+        lines.append(f"| {m} | " + " | ".join(cells) + " |")
+    lines += ["", "![success vs signals](success_vs_signals.png)", ""]
     path = out / "report.md"
     path.write_text("\n".join(lines))
     return path
 
 
-def plot_success_vs_rounds(records: list[dict], methods: list[str], rounds: int, out: Path) -> Path:
-    """Success of each method's current estimate (on the test scene) after each round."""
+def plot_success_vs_signals(records: list[dict], methods: list[str], budget: int, out: Path) -> Path:
+    """success@k against k for each method, with 95 % Wilson bands, one panel per suite."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=120)
-    for m in methods:
-        curves = []
-        for r in records:
-            if r["method"] != m or r.get("error"):
+    suites = sorted({suite_of(r["intention"]) for r in records}) or ["paper"]
+    fig, axes = plt.subplots(1, len(suites), figsize=(5.2 * len(suites), 4.0), dpi=120, squeeze=False)
+    for ax, suite in zip(axes[0], suites, strict=True):
+        drawn = False
+        for m in methods:
+            curves = [r["success_at"] for r in records
+                      if r["method"] == m and _ok(r) and r.get("success_at") and suite_of(r["intention"]) == suite]
+            if not curves:
                 continue
-            c = list(r.get("per_round_success") or [])
-            if not c:
-                continue
-            # After an early "done" the estimate no longer changes: carry the last value forward.
-            curves.append(c + [c[-1]] * (rounds - len(c)))
-        if not curves:
-            continue
-        mean = np.mean(np.array([c[:rounds] for c in curves], dtype=float), axis=0)
-        ax.plot(range(1, len(mean) + 1), mean, marker="o", label=f"{m} (n={len(curves)})")
-    ax.set_xlabel("signals given (round)")
-    ax.set_ylabel("success of the current estimate")
-    ax.set_ylim(-0.05, 1.05)
-    ax.set_xticks(range(1, rounds + 1))
-    ax.grid(alpha=0.3)
-    ax.legend(loc="lower right", fontsize=8)
-    ax.set_title("Success vs. rounds (test scene, symbolic check)")
+            ks, mean, lo, hi = [], [], [], []
+            for k in range(budget + 1):
+                vals = [c[k] for c in curves if k < len(c) and c[k] is not None]
+                if vals:
+                    ks.append(k)
+                    mean.append(np.mean(vals))
+                    a, b = wilson(sum(vals), len(vals))
+                    lo.append(a)
+                    hi.append(b)
+            style = "--" if m in BASELINES else "-"
+            ax.plot(ks, mean, style, marker="o", ms=3, label=f"{m} (n={len(curves)})")
+            ax.fill_between(ks, lo, hi, alpha=0.12)
+            drawn = True
+        ax.set_title(f"suite: {suite}")
+        ax.set_xlabel("signals given (k)")
+        ax.set_ylim(-0.02, 1.02)
+        ax.grid(alpha=0.3)
+        if drawn:
+            ax.legend(loc="upper left", fontsize=7)
+    axes[0][0].set_ylabel("success of the current answer (test scenes)")
     fig.tight_layout()
-    path = out / "success_vs_rounds.png"
+    path = out / "success_vs_signals.png"
     fig.savefig(path)
     plt.close(fig)
     return path

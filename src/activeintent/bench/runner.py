@@ -1,17 +1,15 @@
 """Runs every (method, intention, trial) episode; resumable and parallel.
 
-Trial t of every method uses the same episode seed (derived from the bench seed, the
-intention and t), hence the same scenes, layouts and user noise: methods are compared on
-identical work. Each finished episode is appended to ``results.jsonl`` as one line, flushed
-and fsynced by the single parent process, so a killed run loses at most the episodes in
-flight; a torn last line is dropped on resume.
+Trial t of every method uses the same episode seed (from the bench seed, the intention and t:
+the same query scenes and user noise) and every method *and intention* of trial t the same
+test scenes (from the bench seed and t only). Each finished episode is appended to
+``results.jsonl`` by the single parent process (records.py), so a killed run loses at most
+the episodes in flight; a torn last line is dropped on resume.
 """
 
 from __future__ import annotations
 
-import hashlib
 import json
-import os
 import traceback
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
@@ -21,7 +19,8 @@ from pathlib import Path
 
 from pydantic import BaseModel, Field
 
-from activeintent.intentions.registry import PAPER_INTENTIONS
+from activeintent.protocol import trial_seeds
+from activeintent.records import append_result, dumps, read_results
 from activeintent.runner import RunOptions
 
 
@@ -42,85 +41,54 @@ class WorkItem(BaseModel):
 
 class BenchOptions(BaseModel):
     methods: list[str]
-    intentions: list[str] = Field(default_factory=lambda: list(PAPER_INTENTIONS))
+    intentions: list[str] = Field(default_factory=list)
     intention_files: list[str] = Field(default_factory=list)
-    trials: int = 5
-    seed: int = 0
-    jobs: int = 1
+    trials: int = Field(20, ge=1)
+    seed: int = Field(0, ge=0)
+    jobs: int = Field(1, ge=1)
     retry_errors: bool = False
-    run: RunOptions = Field(default_factory=RunOptions)  # model, executor, user… shared by all episodes
+    keep_episodes: bool = False  # per-episode folders (rounds.jsonl, summary.json)
+    run: RunOptions = Field(default_factory=lambda: RunOptions(video="none"))
 
     def items(self) -> list[WorkItem]:
         names = list(self.intentions) + list(self.intention_files)
         return [WorkItem(method=m, intention=i, trial=t) for t in range(self.trials) for i in names for m in self.methods]
 
 
-def episode_seed(bench_seed: int, intention: str, trial: int) -> int:
-    """Same for every method: a stable hash (not Python's salted hash) of seed, intention, trial."""
-    digest = hashlib.sha256(f"{bench_seed}|{intention}|{trial}".encode()).digest()
-    return int.from_bytes(digest[:4], "little")
+def protocol_fields(run: RunOptions) -> dict:
+    """What every results line records about how it was measured."""
+    return {"env": run.env, "user_preset": run.user, "budget": run.budget, "new_scene": run.new_scene,
+            "prior": run.prior, "test_scenes": run.test_scenes, "llm": run.llm, "executor": run.executor}
 
 
-def read_results(path: Path) -> list[dict]:
-    """Valid records of ``results.jsonl``; a torn or corrupt line is dropped (and the file rewritten)."""
-    if not path.exists():
-        return []
-    good, bad = [], 0
-    for line in path.read_text().splitlines():
-        try:
-            rec = json.loads(line)
-            if isinstance(rec, dict) and {"method", "intention", "trial"} <= rec.keys():
-                good.append(rec)
-                continue
-        except json.JSONDecodeError:
-            pass
-        bad += int(bool(line.strip()))
-    if bad:
-        tmp = path.with_suffix(".jsonl.tmp")
-        tmp.write_text("".join(json.dumps(r) + "\n" for r in good))
-        os.replace(tmp, path)
-    return good
-
-
-def append_result(path: Path, record: dict) -> None:
-    line = json.dumps(record) + "\n"
-    with path.open("a") as f:
-        f.write(line)
-        f.flush()
-        os.fsync(f.fileno())
-
-
-def run_item(item: WorkItem, options: RunOptions, bench_seed: int, out: str) -> dict:
+def run_item(item: WorkItem, options: RunOptions, bench_seed: int, out: str, keep: bool) -> dict:
     """One episode in a worker process (own simulator client, own model handles)."""
     user_defined = ".py:" in item.intention
+    seed, test_seed = trial_seeds(bench_seed, item.intention, item.trial)
     run = options.model_copy(update={
         "method": item.method,
         "intention": None if user_defined else item.intention,
         "intention_file": item.intention if user_defined else None,
-        "seed": episode_seed(bench_seed, item.intention, item.trial),
-        "track_progress": True,
+        "seed": seed, "test_seed": test_seed,
     })
-    base = {"method": item.method, "intention": item.intention, "trial": item.trial, "seed": run.seed,
-            "user": run.user.model_dump(mode="json")}
+    base = {"method": item.method, "intention": item.intention, "trial": item.trial, **protocol_fields(run)}
     try:
         from activeintent.runner import build_episode
 
-        episode = build_episode(run, Path(out) / "episodes" / item.slug)
+        episode = build_episode(run, Path(out) / "episodes" / item.slug if keep else None)
         try:
             result = episode.run()
         finally:
             episode.env.close()
-        return {**result.model_dump(mode="json"), **base}
+        record = result.model_dump(mode="json")
+        record.pop("tests", None)  # per-scene detail stays in the episode folder
+        return {**record, **base}
     except Exception as err:  # noqa: BLE001 - recorded, never crashes the benchmark
-        return {**base, "success": False, "success_rate": 0.0, "error": f"{type(err).__name__}: {err}",
+        return {**base, "success": None, "error": f"{type(err).__name__}: {err}",
                 "traceback": traceback.format_exc(limit=8)}
 
 
-def run_bench(
-    options: BenchOptions,
-    out: Path,
-    on_done: Callable[[dict, int, int], None] | None = None,
-) -> list[dict]:
+def run_bench(options: BenchOptions, out: Path, on_done: Callable[[dict, int, int], None] | None = None) -> list[dict]:
     """Run what is missing from ``out/results.jsonl``; returns all records."""
     out.mkdir(parents=True, exist_ok=True)
     results_path = out / "results.jsonl"
@@ -130,7 +98,7 @@ def run_bench(
     if options.retry_errors:
         kept = [r for r in records if not r.get("error")]
         if len(kept) != len(records):
-            results_path.write_text("".join(json.dumps(r) + "\n" for r in kept))
+            results_path.write_text("".join(dumps(r) + "\n" for r in kept))
         records = kept
     done = {(r["method"], r["intention"], r["trial"]) for r in records}
     todo = [it for it in options.items() if it.key not in done]
@@ -138,7 +106,7 @@ def run_bench(
     finished = total - len(todo)
     if on_done:
         on_done({}, finished, total)
-    for record in _execute(todo, options.run, options.seed, out, options.jobs):
+    for record in _execute(todo, options, out):
         append_result(results_path, record)
         records.append(record)
         finished += 1
@@ -147,8 +115,7 @@ def run_bench(
     return records
 
 
-# Options that change what an episode does; methods, intentions and trials may grow on resume.
-_SETTINGS = ("seed", "run")
+_SETTINGS = ("seed", "run")  # methods, intentions and trials may grow on resume; these may not change
 
 
 def _check_same_settings(options: BenchOptions, path: Path) -> None:
@@ -160,26 +127,25 @@ def _check_same_settings(options: BenchOptions, path: Path) -> None:
     changed = [k for k in _SETTINGS if before.get(k) != now.get(k)]
     if changed:
         diff = "; ".join(f"{k}: {before.get(k)} → {now.get(k)}" for k in changed)
-        raise ValueError(
-            f"{path.parent} holds results made with other settings ({diff}). "
-            "Use another --out, or the same settings to resume."
-        )
+        raise ValueError(f"{path.parent} holds results made with other settings ({diff}). "
+                         "Use another --out, or the same settings to resume.")
 
 
-def _execute(todo: list[WorkItem], run: RunOptions, seed: int, out: Path, jobs: int) -> Iterator[dict]:
-    if jobs <= 1:
+def _execute(todo: list[WorkItem], options: BenchOptions, out: Path) -> Iterator[dict]:
+    args = (options.run, options.seed, str(out), options.keep_episodes)
+    if options.jobs <= 1:
         for item in todo:
-            yield run_item(item, run, seed, str(out))
+            yield run_item(item, *args)
         return
     queue = list(todo)
     while queue:
         suspects: list[WorkItem] = []
-        with _pool(jobs) as pool:
+        with _pool(options.jobs) as pool:
             pending: dict[Future, WorkItem] = {}
             while (queue or pending) and not suspects:
-                while queue and len(pending) < jobs:
+                while queue and len(pending) < options.jobs:
                     item = queue.pop(0)
-                    pending[pool.submit(run_item, item, run, seed, str(out))] = item
+                    pending[pool.submit(run_item, item, *args)] = item
                 finished, _ = wait(pending, return_when=FIRST_COMPLETED)
                 for fut in finished:
                     if isinstance(fut.exception(), BrokenProcessPool):
@@ -191,11 +157,11 @@ def _execute(todo: list[WorkItem], run: RunOptions, seed: int, out: Path, jobs: 
         # error (e.g. a native crash), the others give their results; then go on in parallel.
         for item in suspects:
             with _pool(1) as alone:
-                fut = alone.submit(run_item, item, run, seed, str(out))
+                fut = alone.submit(run_item, item, *args)
                 wait([fut])
                 if isinstance(fut.exception(), BrokenProcessPool):
                     yield {"method": item.method, "intention": item.intention, "trial": item.trial,
-                           "success": False, "success_rate": 0.0, "error": "worker process died"}
+                           **protocol_fields(options.run), "success": None, "error": "worker process died"}
                 else:
                     yield fut.result()
 

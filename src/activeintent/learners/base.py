@@ -3,59 +3,64 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from typing import Literal
 
 import numpy as np
 from pydantic import BaseModel, Field
 
-from activeintent.signals import PreferenceFeedback, StopFeedback
-from activeintent.sim.trajectory import Trajectory
+from activeintent.signals import Answer
 from activeintent.world import Scene, Skill, WorldState
+from activeintent.world.trajectory import Trajectory
 
 
 class Estimate(BaseModel):
-    """z (``preference``) and y (``goals``): one goal, or y^a and y^b for the preference method.
+    """z (the estimated intention, one sentence) and y (``goals``): one goal, or y^a and y^b
+    when the signal shows two trajectories.
 
     A learner that has already grounded y in skills gives ``plans`` (one per goal) and the
-    executor is skipped. ``done`` = the learner is confident and needs no more signals.
+    executor is skipped. ``done`` = the learner says it is confident (recorded; in the
+    benchmark it does not end the episode). ``why`` explains the choice (e.g. EIG of the query
+    and of the alternatives it beat; belief before the answer).
     """
 
-    preference: str
+    z: str
     goals: list[str]
     plans: list[list[Skill]] | None = None
     done: bool = False
+    why: dict = Field(default_factory=dict)
 
 
 class RoundRecord(BaseModel):
-    """One feedback round: what was shown and what the user said."""
+    """One feedback round: what was shown and what the user answered."""
 
     index: int
     scene: Scene
     estimate: Estimate
     plans: list[list[Skill]] = Field(default_factory=list)  # executed plans, one per goal
     failures: list[str | None] = Field(default_factory=list)  # per goal: why execution failed
-    feedback: PreferenceFeedback | StopFeedback | None = None
+    answer: Answer | None = None
     retrieved: str | None = None  # r (stop methods)
 
 
 class Learner(ABC):
     """Base class of all methods. The episode loop calls, per round:
     ``design_scene`` → ``estimate`` → (execute, user answers h) → ``observe``;
-    and at the end ``final`` on a fresh scene."""
+    and ``final`` on each test scene, after every signal."""
 
     name: str = ""
-    signal: Literal["preference", "stop"] = "stop"
+    signal: str = "stop"  # the name of the signal plug-in it reads
+    asks: bool = True  # False for the zero-signal baseline: it never shows a query
+    may_finish: bool = False  # may its "done" end an episode outside the benchmark?
     retriever: str | None = None  # which retriever produced r (stop methods), for the logs
 
     def execution_failed(self, goal: str, reason: str) -> None:  # noqa: B027 - optional hook
         """The executor could not turn goal y into motion; the next estimate should be simpler."""
 
     def stats(self) -> dict:
-        """Method-specific figures for the results (e.g. bits gained per signal)."""
+        """Method-specific figures for the results."""
         return {}
 
     def drain_transcript(self) -> list[dict]:
-        """Model calls made since the last drain (prompt, answer, timing), for rounds.jsonl."""
+        """Model calls and belief snapshots since the last drain, for rounds.jsonl."""
         return []
 
     def design_scene(self, rng: np.random.Generator) -> Scene | None:
@@ -72,4 +77,4 @@ class Learner(ABC):
 
     @abstractmethod
     def final(self, scene: Scene, state: WorldState) -> Estimate:
-        """The final z and one y for a fresh test scene."""
+        """The current z and one y for a test scene (called after every signal)."""

@@ -31,9 +31,9 @@ from activeintent.learners.schemas import (
     scene_schema,
 )
 from activeintent.llm.base import ChatModel, ImagePart, Message, ModelError, TextPart
-from activeintent.signals import StopFeedback
-from activeintent.sim.trajectory import Trajectory
+from activeintent.signals.stop import StopAnswer
 from activeintent.world import ALL_OBJECTS, Scene, SceneError, WorldState, describe_state, layout
+from activeintent.world.trajectory import Trajectory
 
 
 class PaperLearnerConfig(BaseModel):
@@ -146,11 +146,12 @@ class PreferenceLearner(_ModelLearner):
 
     name = "preference"
     signal = "preference"
+    may_finish = True  # in the paper only the preference method could answer "done"
 
     def _round_text(self, rec: RoundRecord, r: str | None) -> str:
-        h = rec.feedback.describe() if rec.feedback else "no answer"
+        h = rec.answer.describe() if rec.answer else "no answer"
         a, b = (rec.estimate.goals + ["", ""])[:2]
-        return (f"Round {rec.index + 1}: scene: {rec.scene}. z_{rec.index + 1}: {rec.estimate.preference} "
+        return (f"Round {rec.index + 1}: scene: {rec.scene}. z_{rec.index + 1}: {rec.estimate.z} "
                 f"Goal A: {a}. Goal B: {b}. h_{rec.index + 1}: {h}.")
 
     def _intention(self) -> IntentionAnswer:
@@ -159,7 +160,7 @@ class PreferenceLearner(_ModelLearner):
 
     def estimate(self, scene: Scene, state: WorldState) -> Estimate:
         z = self._intention()
-        return Estimate(preference=z.preference, goals=self._goals(scene, state, z.preference, 2), done=z.done)
+        return Estimate(z=z.preference, goals=self._goals(scene, state, z.preference, 2), done=z.done)
 
     def observe(self, record: RoundRecord, trajectories: list[Trajectory]) -> str | None:
         self.history.append(record)
@@ -169,15 +170,15 @@ class PreferenceLearner(_ModelLearner):
 
     def final(self, scene: Scene, state: WorldState) -> Estimate:
         z = self._intention()
-        return Estimate(preference=z.preference, goals=self._goals(scene, state, z.preference, 1), done=True)
+        return Estimate(z=z.preference, goals=self._goals(scene, state, z.preference, 1), done=True)
 
 
 class _StopLearner(_ModelLearner):
     signal = "stop"
 
     def _round_text(self, rec: RoundRecord, r: str | None) -> str:
-        h = rec.feedback.describe() if rec.feedback else "no answer"
-        text = (f"Round {rec.index + 1}: scene: {rec.scene}. z_{rec.index + 1}: {rec.estimate.preference} "
+        h = rec.answer.describe() if rec.answer else "no answer"
+        text = (f"Round {rec.index + 1}: scene: {rec.scene}. z_{rec.index + 1}: {rec.estimate.z} "
                 f"y_{rec.index + 1}: {rec.estimate.goals[0]}. h_{rec.index + 1}: {h}.")
         return text + (f" r_{rec.index + 1}: {r}" if r else "")
 
@@ -189,11 +190,11 @@ class _StopLearner(_ModelLearner):
     def estimate(self, scene: Scene, state: WorldState) -> Estimate:
         extra = self._latest_evidence()
         z = self._intention(extra)
-        return Estimate(preference=z.preference, goals=self._goals(scene, state, z.preference, 1, extra), done=z.done)
+        return Estimate(z=z.preference, goals=self._goals(scene, state, z.preference, 1, extra), done=z.done)
 
     def final(self, scene: Scene, state: WorldState) -> Estimate:
         z = self._intention(self._latest_evidence())
-        return Estimate(preference=z.preference, goals=self._goals(scene, state, z.preference, 1), done=True)
+        return Estimate(z=z.preference, goals=self._goals(scene, state, z.preference, 1), done=True)
 
     def _latest_evidence(self) -> list[TextPart | ImagePart] | None:
         return None
@@ -217,8 +218,8 @@ class MllmLlmLearner(_StopLearner):
         self.retriever = retriever
 
     def observe(self, record: RoundRecord, trajectories: list[Trajectory]) -> str | None:
-        h = record.feedback
-        assert isinstance(h, StopFeedback)
+        h = record.answer
+        assert isinstance(h, StopAnswer)
         r = None
         if trajectories and not h.new_scene:
             traj, goal = trajectories[0], record.estimate.goals[0]
@@ -247,8 +248,8 @@ class MllmLearner(_StopLearner):
         self._evidence: tuple[PromptH, Trajectory] | None = None
 
     def observe(self, record: RoundRecord, trajectories: list[Trajectory]) -> str | None:
-        h = record.feedback
-        assert isinstance(h, StopFeedback)
+        h = record.answer
+        assert isinstance(h, StopAnswer)
         self._evidence = None
         if trajectories and not h.new_scene:
             self._evidence = (prompt_h(trajectories[0], h, record.estimate.goals[0], self.config.epsilon), trajectories[0])

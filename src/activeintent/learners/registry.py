@@ -1,55 +1,129 @@
-"""Method names on the command line → learners."""
+"""Methods (learners) by command-line name: the paper's, ours, and the baselines.
+
+``bayes-<signal>`` exists for every registered signal, plug-ins included. Register your own
+learner with ``METHODS.register("name", Method(...))`` in a file passed with ``--plugin``.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+
 from activeintent.learners.base import Learner
 from activeintent.llm.base import ChatModel
+from activeintent.registry import Registry, UnknownName
+
+
+@dataclass
+class LearnerContext:
+    """Everything a method may need to build its learner (from the run's options)."""
+
+    llm: ChatModel | None = None
+    vlm: ChatModel | None = None
+    retriever: str = "symbolic"
+    seed: int = 0
+    design_scenes: bool = True
+    epsilon: float = 2.0
+    prior: str = "length"
+
+
+@dataclass
+class Method:
+    signal: str
+    needs_llm: bool
+    build: Callable[[LearnerContext], Learner]
+    help: str = ""
+    family: str = "ours"  # paper | ours | baseline
+
+    def __call__(self, ctx: LearnerContext) -> Learner:
+        if self.needs_llm and ctx.llm is None:
+            raise ValueError("this method needs a language model (--llm embedded, gguf:…, openai:…)")
+        return self.build(ctx)
+
+
+METHODS: Registry[Method] = Registry("method")
+
+
+def _bayes(signal: str, kind: str = "eig") -> Callable[[LearnerContext], Learner]:
+    def build(ctx: LearnerContext) -> Learner:
+        from activeintent.learners.bayes.learner import (
+            BayesConfig,
+            BayesLearner,
+            RandomQueryLearner,
+            ZeroSignalLearner,
+        )
+
+        cls = {"eig": BayesLearner, "random": RandomQueryLearner, "zero": ZeroSignalLearner}[kind]
+        return cls(signal, rng=ctx.seed, llm=ctx.llm, config=BayesConfig(prior=ctx.prior))  # type: ignore[arg-type]
+
+    return build
+
+
+def _paper(kind: str) -> Callable[[LearnerContext], Learner]:
+    def build(ctx: LearnerContext) -> Learner:
+        from activeintent.learners.paper import (
+            MllmLearner,
+            MllmLlmLearner,
+            PaperLearnerConfig,
+            PreferenceLearner,
+        )
+
+        config = PaperLearnerConfig(design_scenes=ctx.design_scenes, epsilon=ctx.epsilon)
+        if kind == "preference":
+            return PreferenceLearner(ctx.llm, config)  # type: ignore[arg-type]
+        if kind == "mllm":
+            return MllmLearner(ctx.vlm or ctx.llm, config)  # type: ignore[arg-type]
+        if ctx.retriever not in ("vision", "symbolic"):
+            raise ValueError(f"Unknown retriever {ctx.retriever!r}; valid retrievers: vision, symbolic.")
+        return MllmLlmLearner(ctx.llm, ctx.vlm, retriever=ctx.retriever, config=config)  # type: ignore[arg-type]
+
+    return build
+
+
+METHODS.register("preference", lambda: Method("preference", True, _paper("preference"),
+                 "the paper's eq. 1–2: the LLM estimates z, then two goals y^a, y^b", "paper"))
+METHODS.register("mllm", lambda: Method("stop", True, _paper("mllm"),
+                 "the paper: one multimodal model reads prompt(h) (eq. 3) and gives z, y", "paper"))
+METHODS.register("mllm-llm", lambda: Method("stop", True, _paper("mllm-llm"),
+                 "the paper's best: a retriever gives r (eq. 4), the LLM gives z, y (eq. 5–6)", "paper"))
+METHODS.register("bayes-preference", lambda: Method("preference", False, _bayes("preference"),
+                 "ours: belief over z, A/B queries by expected information gain"))
+METHODS.register("bayes-stop", lambda: Method("stop", False, _bayes("stop"),
+                 "ours: belief over z, stop queries by expected information gain"))
+METHODS.register("zero-signal", lambda: Method("stop", False, _bayes("stop", "zero"),
+                 "baseline: the prior's best guess, asks nothing", "baseline"))
+METHODS.register("random-query", lambda: Method("stop", False, _bayes("stop", "random"),
+                 "baseline: bayes-stop's belief update with random stop queries", "baseline"))
+METHODS.register("random-query-preference", lambda: Method("preference", False, _bayes("preference", "random"),
+                 "baseline: bayes-preference's belief update with random A/B queries", "baseline"))
 
 PAPER_METHODS = ("preference", "mllm", "mllm-llm")
-BAYES_METHODS = ("bayes-preference", "bayes-stop")
-METHODS = PAPER_METHODS + BAYES_METHODS
-SIGNAL = {"preference": "preference", "mllm": "stop", "mllm-llm": "stop",
-          "bayes-preference": "preference", "bayes-stop": "stop"}
+BASELINES = ("zero-signal", "random-query", "random-query-preference")
 
 
-def check_method(method: str) -> str:
-    if method not in METHODS:
-        raise ValueError(f"Unknown method {method!r}; valid methods: {', '.join(METHODS)}.")
-    return method
+def get_method(name: str) -> Method:
+    """The method called ``name``; ``bayes-<signal>`` for any registered signal."""
+    if name not in METHODS and name.startswith("bayes-"):
+        from activeintent.signals import SIGNALS
+
+        signal = name.removeprefix("bayes-")
+        if signal in SIGNALS:
+            METHODS.register(name, lambda: Method(signal, False, _bayes(signal), f"ours, for the {signal} signal"))
+    return METHODS.make(name)
 
 
-def make_learner(
-    method: str,
-    *,
-    llm: ChatModel | None,
-    vlm: ChatModel | None = None,
-    retriever: str = "symbolic",
-    seed: int = 0,
-    design_scenes: bool = True,
-    epsilon: float = 2.0,
-) -> Learner:
-    """Build the learner for ``method``. Paper methods need ``llm``; the Bayesian ones use it
-    (when given) only to propose open-ended hypotheses."""
-    check_method(method)
-    if method in BAYES_METHODS:
-        from activeintent.learners.bayes.learner import BayesPreferenceLearner, BayesStopLearner
+def check_method(name: str) -> str:
+    get_method(name)
+    return name
 
-        cls = BayesPreferenceLearner if method == "bayes-preference" else BayesStopLearner
-        return cls(rng=seed, llm=llm)
-    from activeintent.learners.paper import (
-        MllmLearner,
-        MllmLlmLearner,
-        PaperLearnerConfig,
-        PreferenceLearner,
-    )
 
-    if llm is None:
-        raise ValueError(f"Method {method!r} needs a language model (--llm).")
-    config = PaperLearnerConfig(design_scenes=design_scenes, epsilon=epsilon)
-    if method == "preference":
-        return PreferenceLearner(llm, config)
-    if method == "mllm":
-        return MllmLearner(vlm or llm, config)
-    if retriever not in ("vision", "symbolic"):
-        raise ValueError(f"Unknown retriever {retriever!r}; valid: vision, symbolic.")
-    return MllmLlmLearner(llm, vlm, retriever=retriever, config=config)  # type: ignore[arg-type]
+def method_names() -> list[str]:
+    return METHODS.names()
+
+
+def make_learner(name: str, ctx: LearnerContext) -> Learner:
+    return get_method(name)(ctx)
+
+
+__all__ = ["BASELINES", "METHODS", "PAPER_METHODS", "LearnerContext", "Method", "UnknownName",
+           "check_method", "get_method", "make_learner", "method_names"]

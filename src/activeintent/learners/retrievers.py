@@ -16,9 +16,9 @@ from typing import Literal
 
 from activeintent.learners import prompts
 from activeintent.llm.base import ImagePart, Message, TextPart
-from activeintent.signals import StopFeedback
-from activeintent.sim.trajectory import Trajectory
+from activeintent.signals.stop import StopAnswer
 from activeintent.world import describe_skill, describe_state, relations
+from activeintent.world.trajectory import Trajectory
 
 RetrieverName = Literal["vision", "symbolic"]
 RETRIEVERS: tuple[str, ...] = ("vision", "symbolic")
@@ -46,7 +46,7 @@ class PromptH:
         return [m.label for m in self.moments]
 
 
-def prompt_h(traj: Trajectory, h: StopFeedback, goal: str, epsilon: float) -> PromptH:
+def prompt_h(traj: Trajectory, h: StopAnswer, goal: str, epsilon: float) -> PromptH:
     """Build prompt(h) exactly as eq. 3 (ε in seconds)."""
     x = prompts.sections("eq3_prompt_h")
     if h.stop_time is None:
@@ -83,11 +83,12 @@ def as_text(ph: PromptH, traj: Trajectory) -> str:
     return "\n".join(lines)
 
 
-def symbolic_retrieval(ph: PromptH, traj: Trajectory, h: StopFeedback) -> str:
+def symbolic_retrieval(ph: PromptH, traj: Trajectory, h: StopAnswer) -> str:
     """r from the trajectory log: what changed between I_0/I_b and I_s, and the skill at the stop."""
     if h.stop_time is None:
-        final = describe_state(traj.final_state or traj.state_at(traj.duration))
-        return f"The user accepted the whole execution. Final scene: {final}"
+        if not traj.moved_anything:  # nothing was shown: no stop is no approval
+            return "The robot could not carry out the goal, so nothing moved; the user had nothing to judge."
+        return f"The user watched the whole execution without stopping it. Final scene: {describe_state(traj.outcome)}"
     step = traj.step_at(h.stop_time)
     doing = describe_skill(traj.steps[step].skill) if step is not None and traj.steps else "nothing"
     first = relations(traj.state_at(ph.moments[0].t))

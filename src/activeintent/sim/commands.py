@@ -33,13 +33,13 @@ def register(app: typer.Typer) -> None:
         from rich.console import Console
         from rich.progress import Progress
 
-        from activeintent.sim.env import TabletopEnv
+        from activeintent.sim.env import PyBulletEnv
         from activeintent.sim.video import export_video
         from activeintent.world import describe_plan, describe_state
 
         console = Console()
         plan = _demo_plan()
-        with TabletopEnv() as env:
+        with PyBulletEnv() as env:
             state = env.reset(list(DEMO_SCENE), seed)
             console.print(f"[bold]Scene[/] (seed {seed}): {', '.join(DEMO_SCENE)}")
             console.print(f"[bold]Before:[/] {describe_state(state)}")
@@ -74,11 +74,11 @@ def register(app: typer.Typer) -> None:
 
         import pybullet as p
 
-        from activeintent.sim.env import TabletopEnv
+        from activeintent.sim.env import PyBulletEnv
         from activeintent.sim.render import render_frame
         from activeintent.sim.video import export_video
         results: dict[str, float | int | str] = {}
-        with TabletopEnv() as env:
+        with PyBulletEnv() as env:
             env.reset(list(DEMO_SCENE), 0)
             n = 2000
             start = time.perf_counter()

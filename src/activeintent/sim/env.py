@@ -21,11 +21,11 @@ from pydantic import BaseModel, Field, TypeAdapter, ValidationError, model_valid
 
 from activeintent.sim.assets import create_object, create_table
 from activeintent.sim.robot import FINGER_CLOSED, FINGER_OPEN, HOME_EE, SEED_POSES, Panda
-from activeintent.sim.trajectory import StepRecord, Trajectory
 from activeintent.world.predict import SkillFailure, target_position
 from activeintent.world.scene import BLOCK_SIZE, BOWL_HEIGHT, Scene, SceneError, kind_of, layout
 from activeintent.world.skills import Skill
 from activeintent.world.state import WorldState
+from activeintent.world.trajectory import StepRecord, Trajectory
 
 _SKILL = TypeAdapter(Skill)
 
@@ -77,8 +77,15 @@ class _Log:
         return len(self.step) - 1
 
 
-class TabletopEnv:
-    """A headless PyBullet tabletop with a Panda arm. Owns its own DIRECT client."""
+class PyBulletEnv:
+    """The ``pybullet`` env: a headless PyBullet tabletop with a Panda arm (own DIRECT client).
+
+    Implements :class:`activeintent.envs.Env`; its trajectories carry a renderer, so frames
+    (I_0, I_b, I_s, videos) can be drawn from them later.
+    """
+
+    name = "pybullet"
+    renders = True
 
     def __init__(self, config: SimConfig | None = None):
         self.config = config or SimConfig()
@@ -94,7 +101,7 @@ class TabletopEnv:
         self._current = -1  # index of the skill being executed (-1: idle)
 
     # --- lifecycle ------------------------------------------------------------------------
-    def __enter__(self) -> TabletopEnv:
+    def __enter__(self) -> PyBulletEnv:
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -115,7 +122,7 @@ class TabletopEnv:
     def reset(self, scene: Scene | Sequence[str], seed: int) -> WorldState:
         """Rebuild the world with ``scene`` laid out from ``seed``; returns the settled state."""
         if self.client < 0:
-            raise RuntimeError("this TabletopEnv is closed; create a new one")
+            raise RuntimeError("this PyBulletEnv is closed; create a new one")
         if not isinstance(scene, Scene):
             try:
                 scene = Scene(objects=list(scene))
@@ -126,7 +133,7 @@ class TabletopEnv:
     def reset_to(self, state: WorldState, seed: int = 0) -> WorldState:
         """Rebuild the world with objects at the given positions (e.g. a predicted state)."""
         if self.client < 0:
-            raise RuntimeError("this TabletopEnv is closed; create a new one")
+            raise RuntimeError("this PyBulletEnv is closed; create a new one")
         return self._build(state.scene, dict(state.positions), seed)
 
     def _build(self, scene: Scene, positions: dict[str, tuple[float, float, float]], seed: int) -> WorldState:
@@ -308,7 +315,16 @@ class TabletopEnv:
             object_poses=np.array(log.poses), joint_positions=np.array(log.joints),
             ee_pose=np.array(log.ee), gripper_closed=np.array(log.closed, dtype=bool),
             step_index=np.array(log.step, dtype=np.int64), steps=records,
-            initial_state=initial, final_state=self.state(),
+            initial_state=initial, final_state=self.state(), renderer=_render,
         )
         self._log = None
         return traj
+
+
+TabletopEnv = PyBulletEnv  # the name used before envs became plug-ins
+
+
+def _render(traj: Trajectory, t: float, size: tuple[int, int]) -> np.ndarray:
+    from activeintent.sim.render import render_frame  # imported late: render imports world only
+
+    return render_frame(traj, t, size=size)

@@ -15,8 +15,8 @@ import pybullet_data
 
 from activeintent.sim.assets import color_panda, create_object, create_table, light_panda_urdf
 from activeintent.sim.robot import BASE_POSITION, BASE_YAW, REST_POSE
-from activeintent.sim.trajectory import Trajectory
 from activeintent.world.state import WorldState
+from activeintent.world.trajectory import Trajectory
 
 # An oblique view from the front edge of the table towards the robot, as in Code as Policies:
 # the top side of the workspace (near the robot) is at the top of the image, x grows to the right.

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from activeintent.sim.render import render_frame
-from activeintent.sim.trajectory import Trajectory
+from activeintent.world.trajectory import Trajectory
 
 FORMATS = (".gif", ".webm", ".mp4")
 

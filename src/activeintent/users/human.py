@@ -9,7 +9,7 @@ replayed or stale answer can never become another round's h.
 The clicker's stop time is mapped from the video to the trajectory exactly as a simulated stop
 user's is: video frame k shows trajectory time k / fps, so a stop at media time t (seconds) is
 the trajectory time t, its log tick ``traj.tick_at(t)``, frame ``floor(t * fps)`` and skill
-``traj.step_at(t)``.
+the skill index is not part of h: a person's stop is only a time.
 """
 
 from __future__ import annotations
@@ -19,14 +19,12 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any
 
-from activeintent.signals import PreferenceFeedback, StopFeedback
-from activeintent.sim.trajectory import Trajectory
+from activeintent.signals import Answer, Signal, get_signal
+from activeintent.signals.stop import StopAnswer
 from activeintent.world import Scene
-
-Signal = Literal["preference", "stop"]
-SIGNALS: tuple[str, ...] = ("preference", "stop")
+from activeintent.world.trajectory import Trajectory
 
 
 class SessionCancelled(RuntimeError):
@@ -68,7 +66,7 @@ def video_duration(traj: Trajectory, fps: int) -> float:
     return video_frames(traj, fps) / fps
 
 
-def stop_feedback(traj: Trajectory, t: float, fps: int) -> StopFeedback:
+def stop_answer(traj: Trajectory, t: float, fps: int) -> StopAnswer:
     """h for a stop pressed at video media time ``t`` (seconds).
 
     Raises :class:`AnswerRejected` (422) when t is not a finite time inside the video. The
@@ -81,13 +79,11 @@ def stop_feedback(traj: Trajectory, t: float, fps: int) -> StopFeedback:
             f"stop time {t!r} s is outside the video (valid: 0 to {length:.3f} s)", status=422
         )
     stop_time = min(float(t), traj.duration)
-    frame = int(math.floor(stop_time * fps + 1e-9))
-    return StopFeedback(
-        stop_time=stop_time,
-        tick=traj.tick_at(stop_time),
-        frame=frame,
-        step_index=traj.step_at(stop_time),
-    )
+    return StopAnswer(stop_time=stop_time, tick=traj.tick_at(stop_time),
+                      frame=int(math.floor(stop_time * fps + 1e-9)))
+
+
+stop_feedback = stop_answer  # the name used before signals became plug-ins
 
 
 class HumanUser:
@@ -100,24 +96,23 @@ class HumanUser:
 
     def __init__(
         self,
-        signal: Signal,
+        signal: Signal | str,
         timeout: float | None = 1800.0,
         present: Callable[[Question], Any] | None = None,
     ):
-        if signal not in SIGNALS:
-            raise ValueError(f"Unknown signal {signal!r}; valid signals: {', '.join(SIGNALS)}.")
-        self.signal = signal
+        self.sig = get_signal(signal) if isinstance(signal, str) else signal
+        self.signal = self.sig.name
         self.timeout = timeout
         self.present = present
         self._cond = threading.Condition()
         self._question: Question | None = None
-        self._answer: PreferenceFeedback | StopFeedback | None = None
+        self._answer: Answer | None = None
         self._rounds = 0
         self._cancelled: str | None = None
 
     # -- the episode's side ----------------------------------------------------------------
-    def respond(self, scene: Scene, trajectories: list[Trajectory]) -> PreferenceFeedback | StopFeedback:
-        expected = 2 if self.signal == "preference" else 1
+    def respond(self, scene: Scene, trajectories: list[Trajectory]) -> Answer:
+        expected = self.sig.shows
         if len(trajectories) != expected:
             raise ValueError(f"a {self.signal} round shows {expected} trajectories, got {len(trajectories)}")
         question = Question(round=self._rounds + 1, scene=scene, trajectories=list(trajectories))
@@ -160,7 +155,7 @@ class HumanUser:
             self._cond.wait_for(lambda: self._question is not None or self._cancelled, timeout)
             return self._question
 
-    def answer(self, round: int, make: Callable[[Question], PreferenceFeedback | StopFeedback]) -> PreferenceFeedback | StopFeedback:
+    def answer(self, round: int, make: Callable[[Question], Answer]) -> Answer:
         """Answer round ``round``; ``make(question)`` builds h from the question (it may raise
         :class:`AnswerRejected`). Atomic: a rejected answer changes nothing."""
         with self._cond:
@@ -179,8 +174,8 @@ class HumanUser:
                     status=409,
                 )
             h = make(q)
-            if h.kind != self.signal:
-                raise AnswerRejected(f"this session asks for {self.signal} answers, not {h.kind}", status=422)
+            if h.signal != self.signal:
+                raise AnswerRejected(f"this session asks for {self.signal} answers, not {h.signal}", status=422)
             self._answer, self._question = h, None
             self._cond.notify_all()
             return h

@@ -1,256 +1,147 @@
-"""Simulated users with a hidden intention: they give the sparse signal h for τ.
+"""Simulated users with a hidden intention: they give the sparse signal h for what they see.
 
-Two kinds, one per signal:
+A :class:`SimulatedUser` holds one intention and a :class:`UserProfile`; it answers any
+registered signal through that signal's own observation model (``activeintent.signals``),
+with the user's parameters — never the learner's. It first decides whether the scene can
+show its intention at all (the "new scene" answer, with the profile's error rates), then
+samples the signal's answer. All randomness comes from the user's own generator.
 
-- :class:`PreferenceUser` watches τ^a and τ^b and answers A, B or cant_choose (the paper's
-  "goal 1 better" / "goal 2 better" / "both bad or similar"), following the choice model of
-  :mod:`activeintent.users.preference_model`.
-- :class:`StopUser` watches one τ and presses stop shortly after the robot starts a skill that
-  moves away from the intention (or never, when nothing goes wrong).
-
-Both ask for a new scene (the UI's "New Env") when the scene cannot show the intention. All
-randomness comes from the numpy Generator they are given; every parameter is in
-:class:`UserConfig`, which the episode logs.
+Presets (``--user``): ``exact`` (no noise; for debugging), ``paper`` (mild noise), ``human``
+(the default for published numbers; see :data:`PRESETS` for each figure and its source).
+Users never import learners, and learners never import users.
 """
 
 from __future__ import annotations
 
-import math
-from typing import Literal
+from typing import Any
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from activeintent.intentions.base import Intention
-from activeintent.signals import PreferenceFeedback, StopFeedback
-from activeintent.sim.trajectory import StepRecord, Trajectory
-from activeintent.users.preference_model import (
-    outcome_similarity,
-    outcome_utility,
-    preference_probabilities,
-    sample_choice,
-)
+from activeintent.registry import Registry
+from activeintent.signals import Answer, Signal, get_signal
 from activeintent.world import Scene, WorldState
-
-SIGNALS: tuple[str, ...] = ("preference", "stop")
-EXPORT_FPS = 10  # videos are exported at 10 frames per second: frame = floor(t · fps)
+from activeintent.world.trajectory import StepRecord, Trajectory
 
 
-class UserConfig(BaseModel):
-    """Every parameter of a simulated user (logged with each result)."""
+class IntentionJudge:
+    """The :class:`activeintent.signals.Judge` of one hidden intention (n = 1)."""
 
-    model_config = ConfigDict(extra="forbid", ser_json_inf_nan="constants")
+    size = 1
 
-    beta: float = Field(math.inf, ge=0, description="rationality β of the preference user; inf = exact")
-    indifference: float = Field(0.05, ge=0, description="m: utility differences below this are not worth a choice")
-    confusion: float = Field(1.0, ge=0, description="κ: extra log-odds of cant_choose for identical outcomes")
-    reaction_delay_mean: float = Field(0.5, ge=0, description="seconds from a bad move becoming evident to the stop")
-    reaction_delay_sd: float = Field(0.15, ge=0, description="sd of the reaction delay (normal, truncated at 0)")
-    false_stop: float = Field(0.0, ge=0, le=1, description="probability of a stop at a random time for no reason")
-    missed_stop: float = Field(0.0, ge=0, le=1, description="probability of not reacting to a bad move")
-    new_scene_when_infeasible: bool = Field(True, description="ask for a new scene when it cannot show the intention")
-    fps: int = Field(EXPORT_FPS, ge=1, description="video frame rate used for StopFeedback.frame")
-
-
-def final_state(traj: Trajectory) -> WorldState:
-    """The outcome of τ: the logged final state, else the last tick, else the initial state."""
-    if traj.final_state is not None:
-        return traj.final_state
-    if traj.n_ticks > 0:
-        return traj.state_at(traj.duration)
-    if traj.initial_state is not None:
-        return traj.initial_state
-    raise ValueError("the trajectory has no states to judge (no ticks, no initial or final state)")
-
-
-def _state_key(state: WorldState) -> tuple:
-    return tuple(sorted(state.positions.items()))
-
-
-class PreferenceUser:
-    """Prefers the trajectory whose outcome better realises the hidden intention.
-
-    See :mod:`activeintent.users.preference_model` for the exact choice probabilities:
-    P(o) ∝ exp(β·U_o + κ·σ·1[o = C]) with U_A = d/2, U_B = −d/2, U_C = m − |d|/2,
-    d = u(s_a) − u(s_b), u(s) = (score(s) + 1[satisfied(s)]) / 2 and σ the similarity of the two
-    final states. β = ∞ is exact: the better one, or cant_choose when |d| < m (or a tie).
-    """
-
-    signal = "preference"
-
-    def __init__(
-        self,
-        intention: Intention,
-        beta: float = math.inf,
-        similarity_confusion: float = 1.0,
-        rng: np.random.Generator | None = None,
-        indifference: float = 0.05,
-        new_scene_when_infeasible: bool = True,
-    ):
+    def __init__(self, intention: Intention):
         self.intention = intention
-        self.config = UserConfig(
-            beta=beta,
-            confusion=similarity_confusion,
-            indifference=indifference,
-            new_scene_when_infeasible=new_scene_when_infeasible,
-        )
-        self.rng = rng if rng is not None else np.random.default_rng(0)
-        self._memo: tuple[tuple, dict[str, float]] | None = None
+        self._away: dict[tuple, bool] = {}
 
-    @classmethod
-    def from_config(cls, intention: Intention, config: UserConfig, rng: np.random.Generator) -> PreferenceUser:
-        user = cls(intention, rng=rng)
-        user.config = config
-        return user
-
-    def probabilities(self, state_a: WorldState, state_b: WorldState) -> dict[str, float]:
-        """P(h) over A, B, cant_choose for two outcomes."""
-        key = (_state_key(state_a), _state_key(state_b), self.config.model_dump_json())
-        if self._memo is not None and self._memo[0] == key:  # the same pair asked again
-            return dict(self._memo[1])
-        c = self.config
-        probs = preference_probabilities(
-            outcome_utility(self.intention, state_a),
-            outcome_utility(self.intention, state_b),
-            outcome_similarity(state_a, state_b),
-            beta=c.beta,
-            indifference=c.indifference,
-            confusion=c.confusion,
-        )
-        self._memo = (key, probs)
-        return dict(probs)
-
-    def choose(self, state_a: WorldState, state_b: WorldState) -> PreferenceFeedback:
-        """h for two outcomes (final states)."""
-        probs = self.probabilities(state_a, state_b)
-        if math.isinf(self.config.beta):
-            choice = max(probs, key=lambda k: probs[k])
-        else:
-            choice = sample_choice(probs, self.rng)
-        return PreferenceFeedback(choice=choice)  # type: ignore[arg-type]
-
-    def respond(self, scene: Scene, trajectories: list[Trajectory]) -> PreferenceFeedback:
-        """h for τ^a, τ^b shown in ``scene``."""
-        if len(trajectories) != 2:
-            raise ValueError(
-                f"a preference user compares exactly two trajectories (τ^a, τ^b); got {len(trajectories)}"
-            )
-        if self.config.new_scene_when_infeasible and not self.intention.feasible(scene):
-            return PreferenceFeedback(choice="new_scene")
-        return self.choose(final_state(trajectories[0]), final_state(trajectories[1]))
-
-
-class StopUser:
-    """Presses stop shortly after the robot starts a skill that moves away from the intention.
-
-    Watching τ step by step, the user finds the first executed skill whose outcome moves away
-    (``intention.step_moves_away(state_before, state_after, skill)``). A failed skill (not ok)
-    counts only if it visibly made things worse (the score dropped, e.g. it knocked a tower
-    over): the robot trying and failing is not a move away from the intention. Each offending
-    skill is missed independently with probability ``missed_stop`` (the user then reacts to
-    the next one, if any). The stop comes at the skill's reveal time (when its destination
-    becomes evident) plus a reaction delay ~ Normal(mean, sd) truncated at 0; it is clipped to
-    the end of τ. With probability ``false_stop`` the user also presses stop at a uniformly
-    random time although nothing is wrong; the earlier press counts. No press → stop_time None.
-    """
-
-    signal = "stop"
-
-    def __init__(
-        self,
-        intention: Intention,
-        reaction_delay: tuple[float, float] = (0.5, 0.15),
-        false_stop: float = 0.0,
-        missed_stop: float = 0.0,
-        rng: np.random.Generator | None = None,
-        new_scene_when_infeasible: bool = True,
-        fps: int = EXPORT_FPS,
-    ):
-        self.intention = intention
-        self.config = UserConfig(
-            reaction_delay_mean=reaction_delay[0],
-            reaction_delay_sd=reaction_delay[1],
-            false_stop=false_stop,
-            missed_stop=missed_stop,
-            new_scene_when_infeasible=new_scene_when_infeasible,
-            fps=fps,
-        )
-        self.rng = rng if rng is not None else np.random.default_rng(0)
-        self._verdicts: dict[tuple, bool] = {}
-
-    @classmethod
-    def from_config(cls, intention: Intention, config: UserConfig, rng: np.random.Generator) -> StopUser:
-        user = cls(intention, rng=rng)
-        user.config = config
-        return user
+    def utility(self, state: WorldState) -> np.ndarray:
+        score = float(np.clip(self.intention.score(state), 0.0, 1.0))
+        return np.array([0.5 * (score + float(self.intention.satisfied(state)))])
 
     def moves_away(self, step: StepRecord) -> bool:
-        before, after = step.state_before, step.state_after
-        key = (_state_key(before), _state_key(after), step.skill.model_dump_json(), step.ok)
-        if key not in self._verdicts:  # judging needs relations; the same τ is often re-judged
-            if len(self._verdicts) > 512:
-                self._verdicts.clear()
-            if not step.ok:
-                verdict = self.intention.score(after) < self.intention.score(before) - 1e-9
+        """A step moves away when the intention says so; a failed step only when it visibly
+        made things worse (the score dropped, e.g. it knocked a tower over)."""
+        key = (tuple(sorted(step.state_before.positions.items())), tuple(sorted(step.state_after.positions.items())),
+               step.skill.model_dump_json(), step.ok)
+        if key not in self._away:
+            if len(self._away) > 1024:
+                self._away.clear()
+            if step.ok:
+                verdict = self.intention.step_moves_away(step.state_before, step.state_after, step.skill)
             else:
-                verdict = self.intention.step_moves_away(before, after, step.skill)
-            self._verdicts[key] = bool(verdict)
-        return self._verdicts[key]
+                verdict = self.intention.score(step.state_after) < self.intention.score(step.state_before) - 1e-9
+            self._away[key] = bool(verdict)
+        return self._away[key]
 
-    def reaction_delay(self) -> float:
-        mean, sd = self.config.reaction_delay_mean, self.config.reaction_delay_sd
-        if sd == 0:
-            return max(mean, 0.0)
-        for _ in range(1000):  # rejection sampling of the truncated normal
-            delay = float(self.rng.normal(mean, sd))
-            if delay >= 0:
-                return delay
-        return 0.0
-
-    def watch(self, traj: Trajectory) -> StopFeedback:
-        """h for one trajectory."""
-        c = self.config
-        end = traj.duration
-        stops: list[float] = []
+    def first_away(self, traj: Trajectory) -> np.ndarray:
         for step in traj.steps:
-            if not self.moves_away(step):
-                continue
-            if c.missed_stop > 0 and self.rng.random() < c.missed_stop:
-                continue
-            stops.append(traj.time_of(step.reveal_tick) + self.reaction_delay())
-            break
-        if c.false_stop > 0 and self.rng.random() < c.false_stop:
-            stops.append(float(self.rng.uniform(0.0, end)))
-        if not stops:
-            return StopFeedback(stop_time=None)
-        t = float(min(max(min(stops), 0.0), end))
-        return StopFeedback(
-            stop_time=t,
-            tick=traj.tick_at(t),
-            frame=int(math.floor(t * c.fps + 1e-9)),
-            step_index=traj.step_at(t),
-        )
-
-    def respond(self, scene: Scene, trajectories: list[Trajectory]) -> StopFeedback:
-        """h for the one τ shown in ``scene``."""
-        if len(trajectories) != 1:
-            raise ValueError(f"a stop user watches exactly one trajectory; got {len(trajectories)}")
-        if self.config.new_scene_when_infeasible and not self.intention.feasible(scene):
-            return StopFeedback(new_scene=True)
-        return self.watch(trajectories[0])
+            if self.moves_away(step):
+                return np.array([step.index])
+        return np.array([-1])
 
 
-def make_user(
-    signal: Literal["preference", "stop"] | str,
-    intention: Intention,
-    config: UserConfig | None = None,
-    seed: int | np.random.Generator = 0,
-) -> PreferenceUser | StopUser:
-    """A simulated user for ``signal`` holding ``intention``; all its randomness from ``seed``."""
-    config = config or UserConfig()
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-    if signal == "preference":
-        return PreferenceUser.from_config(intention, config, rng)
-    if signal == "stop":
-        return StopUser.from_config(intention, config, rng)
-    raise ValueError(f"Unknown signal {signal!r}; valid signals: {', '.join(SIGNALS)}.")
+class UserProfile(BaseModel):
+    """Every parameter of a simulated user (logged with each result, never shown to learners)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    name: str = "custom"
+    models: dict[str, dict[str, Any]] = Field(
+        default_factory=dict, description="per signal: parameters of its observation model")
+    beta_range: tuple[float, float] | None = Field(
+        None, description="draw the preference rationality β per user, uniformly in this range")
+    new_scene_false: float = Field(0.0, ge=0, le=1, description="P(asks for a new scene although the scene could show the intention)")
+    new_scene_miss: float = Field(0.0, ge=0, le=1, description="P(answers normally although the scene cannot show the intention)")
+
+    def model_for(self, signal: Signal, rng: np.random.Generator) -> BaseModel:
+        params = dict(self.models.get(signal.name, {}))
+        if self.beta_range is not None and "beta" in signal.Model.model_fields:
+            params["beta"] = float(rng.uniform(*self.beta_range))
+        return signal.Model(**params)
+
+
+USER_PRESETS: Registry[UserProfile] = Registry("user preset")
+
+USER_PRESETS.register("exact", lambda: UserProfile(
+    name="exact",
+    models={"preference": {"beta": float("inf"), "lapse": 0.0},
+            "stop": {"delay_mean": 0.5, "delay_sd": 0.15, "late_tail": 0.0, "false_stop": 0.0,
+                     "missed_stop": 0.0, "lapse": 0.0}},
+), help="no noise at all (debugging only: it is the learner's best case)")
+
+USER_PRESETS.register("paper", lambda: UserProfile(
+    name="paper",
+    models={"preference": {"beta": 20.0, "lapse": 0.0},
+            "stop": {"delay_mean": 0.5, "delay_sd": 0.15, "late_tail": 0.0, "false_stop": 0.05,
+                     "missed_stop": 0.05, "lapse": 0.0}},
+    new_scene_false=0.02, new_scene_miss=0.05,
+), help="mild noise: β = 20, 5 % false and missed stops")
+
+# `human`: figures from what is known of people, deliberately unlike any learner's assumption.
+# - Preference rationality: Boltzmann β drawn per user in [2, 5] (on utilities in [0, 1]),
+#   i.e. a user picks the better of two outcomes that differ by half the scale 73–92 % of the time;
+#   indifference margin 0.1, 5 % lapses.
+# - Stop: choice reaction times to visual events are right-skewed, median ≈ 0.6 s with a long
+#   tail, modelled log-normal (mean 0.7 s, sd 0.35 s); a wrong move is only recognised once
+#   the block has travelled 30 % of the way after lifting; 10 % of stops come late (anywhere
+#   after the bad step starts), 5 % false stops, 10 % missed bad moves, 2 % lapses.
+# - "New scene": asked 5 % of the time without reason; 20 % of unusable scenes go unnoticed.
+USER_PRESETS.register("human", lambda: UserProfile(
+    name="human",
+    beta_range=(2.0, 5.0),
+    models={"preference": {"indifference": 0.1, "confusion": 1.0, "lapse": 0.05},
+            "stop": {"delay": "lognormal", "delay_mean": 0.7, "delay_sd": 0.35, "visible_after": 0.3,
+                     "late_tail": 0.1, "false_stop": 0.05, "missed_stop": 0.1, "lapse": 0.02}},
+    new_scene_false=0.05, new_scene_miss=0.2,
+), help="noisy like people (default for published numbers)")
+
+
+def user_profile(preset: str) -> UserProfile:
+    return USER_PRESETS.make(preset)
+
+
+class SimulatedUser:
+    """A user holding ``intention`` who answers queries of ``signal``."""
+
+    def __init__(self, intention: Intention, signal: Signal | str, profile: UserProfile | None = None,
+                 rng: np.random.Generator | int = 0):
+        self.intention = intention
+        self.signal = get_signal(signal) if isinstance(signal, str) else signal
+        self.profile = profile or user_profile("exact")
+        self.rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
+        self.model = self.profile.model_for(self.signal, self.rng)
+        self.judge = IntentionJudge(intention)
+
+    def parameters(self) -> dict:
+        """What this user actually is (β drawn, etc.), for the results; learners never see it."""
+        return {"profile": self.profile.model_dump(mode="json"), "signal_model": self.model.model_dump(mode="json")}
+
+    def respond(self, scene: Scene, trajectories: list[Trajectory]) -> Answer:
+        """h for the trajectories shown in ``scene``."""
+        u = self.rng.random()  # one draw per answer for the new-scene decision
+        if self.intention.feasible(scene):
+            if u < self.profile.new_scene_false:
+                return self.signal.new_scene()
+        elif u >= self.profile.new_scene_miss:
+            return self.signal.new_scene()
+        return self.signal.sample(trajectories, self.judge, self.model, self.rng)

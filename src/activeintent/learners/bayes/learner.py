@@ -1,68 +1,58 @@
 """Bayesian active learners: an explicit belief over z, queries chosen by information gain.
 
-``bayes-preference`` shows two plans y^a, y^b per round; ``bayes-stop`` shows one plan y and
-reads the stop time h. Both keep a posterior over the hypothesis space H (hypotheses.py),
-update it with the likelihood of the user's answer on the *executed* trajectories (the real
-outcome, failed steps included), and pick the next (scene, plans) by expected information
-gain on the symbolic world model. The final answer is the plan with the largest expected
-success under the belief; z is the description of the most probable hypothesis.
+One learner for every signal plug-in (``bayes-preference``, ``bayes-stop``, ``bayes-<your
+signal>``), built APReL-style from separate parts:
+
+- belief.py — w_z over the hypothesis space H, prior from description length (or uniform);
+- the signal's observation model P(h | z) (``activeintent.signals``), with the learner's own
+  assumed parameters, never the user's;
+- candidates.py — the planner: plans of likely hypotheses, predicted on the symbolic env;
+- acquisition.py — the query (scene, plans) with the largest expected information gain;
+- proposals.py — new hypotheses from a language model, scored on every past answer.
+
+The final answer is the plan with the largest expected success under the belief; z is the
+description of the most probable hypothesis.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 from pydantic import BaseModel, Field
 
 from activeintent.learners.base import Estimate, Learner, RoundRecord
-from activeintent.learners.bayes.facts import Facts, facts
-from activeintent.learners.bayes.hypotheses import (
-    Hypothesis,
-    hypothesis_space,
-    log_prior,
-    random_scene,
+from activeintent.learners.bayes.acquisition import Query, select_query
+from activeintent.learners.bayes.belief import Belief, Prior
+from activeintent.learners.bayes.candidates import candidate_plans, predict
+from activeintent.learners.bayes.facts import facts
+from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space, random_scene
+from activeintent.learners.bayes.judge import HypothesisJudge, judge
+from activeintent.llm.base import ChatModel, ModelError
+from activeintent.signals import Answer, Signal, get_signal
+from activeintent.world import (
+    Scene,
+    WorldState,
+    describe_plan,
+    describe_skill,
+    describe_state,
+    layout,
 )
-from activeintent.learners.bayes.likelihood import (
-    PreferenceModel,
-    StopModel,
-    preference_likelihood,
-    stop_likelihood,
-    utility,
-)
-from activeintent.learners.bayes.query import (
-    NEW_SCENE_LAPSE,
-    Outcome,
-    Query,
-    best_preference_query,
-    best_stop_query,
-    candidate_plans,
-    first_away,
-    judge,
-    predict,
-    scene_state,
-    similarity,
-)
-from activeintent.llm.base import ChatModel
-from activeintent.signals import PreferenceFeedback, StopFeedback
-from activeintent.sim.trajectory import Trajectory
-from activeintent.world import Scene, WorldState, describe_plan, describe_skill, describe_state
+from activeintent.world.trajectory import Trajectory
 
 
 class BayesConfig(BaseModel):
     """Settings of the Bayesian learners (none is tuned to particular intentions)."""
 
+    prior: Prior = Field("length", description="length: P(z) ∝ 2^-L(z); uniform: the ablation")
+    choose: str = Field("eig", description="eig: largest expected information gain; random: the baseline")
     n_scenes: int = Field(4, ge=1, description="candidate scenes scored per design_scene")
     top_k: int = Field(16, ge=1, description="plans come from this many most probable hypotheses")
     explore: int = Field(6, ge=0, description="... plus this many random other hypotheses")
     max_plans: int = Field(36, ge=2, description="candidate plans per scene")
-    done_threshold: float = Field(0.95, gt=0, le=1, description="stop early when top z holds this much belief")
-    preference: PreferenceModel = Field(default_factory=PreferenceModel)
-    stop: StopModel = Field(default_factory=StopModel)
-    collapse_ratio: float = Field(
-        3.0, gt=1, description="belief collapse: no hypothesis explains h better than this × the lapse floor"
-    )
+    done_threshold: float = Field(0.95, gt=0, le=1, description="says 'done' when top z holds this much belief")
+    new_scene_error: float = Field(0.1, gt=0, lt=0.5, description="assumed P(a person's new-scene answer is wrong)")
+    surprise: float = Field(0.1, gt=0, lt=1, description="P(h) / max_z P(h|z) below this: ask the model for new z")
     proposal_mass: float = Field(0.05, gt=0, lt=1, description="prior mass given to model-proposed hypotheses")
     max_proposal_calls: int = Field(3, ge=0, description="model calls for new hypotheses per episode")
     hypothesis_seed: int = Field(0, description="seed of the bank that deduplicates H")
@@ -72,158 +62,99 @@ class BayesConfig(BaseModel):
 class Observation:
     """One answered round, kept so that hypotheses added later can be scored on it."""
 
-    kind: str
     scene: Scene
-    feedback: PreferenceFeedback | StopFeedback
-    finals: list[Facts]
-    similarity: float = 0.0
-    steps: list[tuple[Facts, Facts, str, bool]] | None = None
-    reveal: np.ndarray | None = None
-    start: np.ndarray | None = None
-    duration: float = 0.0
+    answer: Answer
+    shown: list[Trajectory]
     texts: list[str] = field(default_factory=list)  # what was shown, in words (for proposals)
-    log_evidence: float = 0.0  # log Σ_z w_z P(h | z) when it was observed (the normaliser)
 
+    @property
+    def feedback(self) -> Answer:  # the name proposals.py reads
+        return self.answer
 
-def _final_state(traj: Trajectory) -> WorldState:
-    if traj.final_state is not None:
-        return traj.final_state
-    if traj.steps:
-        return traj.steps[-1].state_after
-    if traj.n_ticks:
-        return traj.state_at(traj.duration)
-    if traj.initial_state is not None:
-        return traj.initial_state
-    raise ValueError("trajectory without any state")
+    @property
+    def finals(self):
+        return [facts(t.outcome) for t in self.shown]
 
 
 class BayesLearner(Learner):
-    """Shared belief, update and final answer; subclasses choose and read the signal."""
-
-    name = "bayes"
+    """The Bayesian active learner for any registered signal."""
 
     def __init__(
         self,
+        signal: Signal | str,
         rng: np.random.Generator | int | None = None,
         llm: ChatModel | None = None,
         config: BayesConfig | None = None,
         hypotheses: tuple[Hypothesis, ...] | None = None,
     ):
+        self.sig = get_signal(signal) if isinstance(signal, str) else signal
+        self.signal = self.sig.name
+        self.name = f"bayes-{self.signal}"
+        self.model = self.sig.learner_model()  # what the learner assumes of people
         self.rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng or 0)
         self.config = config or BayesConfig()
         self.llm = llm
-        self.hyps: tuple[Hypothesis, ...] = tuple(hypotheses or hypothesis_space(self.config.hypothesis_seed))
-        self.log_w = log_prior(self.hyps)
+        self.belief = Belief(tuple(hypotheses or hypothesis_space(self.config.hypothesis_seed)), self.config.prior)
+        self.judge = HypothesisJudge(self.belief.hyps)
         self.observations: list[Observation] = []
         self.designed: tuple[Scene, Query] | None = None
-        self.collapses = 0
         self.proposal_calls = 0
-        self.log: list[dict] = []  # per round: top hypotheses, gain, collapse, proposals
-        self.prior_entropy = self.entropy_bits()
+        self.proposal_errors: list[str] = []
+        self.log: list[dict] = []
+        self.prior_entropy = self.belief.entropy_bits()
         self._drained = 0
 
-    # ---- belief ----
+    # ---- belief views ----
+
+    @property
+    def hyps(self) -> tuple[Hypothesis, ...]:
+        return self.belief.hyps
 
     @property
     def weights(self) -> np.ndarray:
-        return np.exp(self.log_w - np.logaddexp.reduce(self.log_w))
+        return self.belief.weights
 
     def top(self, n: int = 1) -> list[tuple[Hypothesis, float]]:
-        w = self.weights
-        return [(self.hyps[i], float(w[i])) for i in np.argsort(-w, kind="stable")[:n]]
+        return self.belief.top(n)
+
+    def _snapshot(self) -> dict:
+        return {"top": [(h.description, round(p, 4)) for h, p in self.top(3)],
+                "entropy_bits": round(self.belief.entropy_bits(), 3)}
 
     def stats(self) -> dict:
-        """Information gained: prior minus posterior entropy of the belief, per signal given."""
-        signals = sum(1 for entry in self.log if not entry.get("new_scene"))
-        gained = self.prior_entropy - self.entropy_bits()
         return {
             "hypotheses": len(self.hyps),
+            "prior": self.config.prior,
             "prior_entropy_bits": round(self.prior_entropy, 3),
-            "posterior_entropy_bits": round(self.entropy_bits(), 3),
-            "bits_per_signal": round(gained / signals, 3) if signals else None,
+            "posterior_entropy_bits": round(self.belief.entropy_bits(), 3),
             "top": [(h.name, round(p, 4)) for h, p in self.top(3)],
-            "collapses": self.collapses,
+            "proposal_calls": self.proposal_calls,
+            "proposal_errors": self.proposal_errors,
+            "proposed_kept": sum(len(e.get("proposed", [])) for e in self.log),
         }
 
     def drain_transcript(self) -> list[dict]:
-        """The belief after each update (top hypotheses, entropy), for rounds.jsonl."""
         out = [dict(entry, template="belief") for entry in self.log[self._drained:]]
         self._drained = len(self.log)
         return out
 
-    def entropy_bits(self) -> float:
-        w = self.weights
-        return float(-(w * np.log2(np.clip(w, 1e-300, None))).sum())
+    # ---- queries ----
 
-    def update(self, likelihood: np.ndarray) -> None:
-        """Bayes' rule: w_z ← w_z · P(h | z) (in logs)."""
-        self.log_w = self.log_w + np.log(np.clip(likelihood, 1e-300, None))
-        self.log_w -= np.logaddexp.reduce(self.log_w)
-
-    def add_hypotheses(self, new: list[Hypothesis]) -> None:
-        """Add hypotheses with ``proposal_mass`` of prior, scored on every past observation."""
-        if not new:
-            return
-        new = [h for h in new if h.name not in {g.name for g in self.hyps}]
-        if not new:
-            return
-        old = len(self.hyps)
-        self.hyps = self.hyps + tuple(new)
-        each = math.log(self.config.proposal_mass / len(new))
-        log_new = np.full(len(new), each)
-        sub = tuple(new)
-        for obs in self.observations:
-            log_new += np.log(np.clip(self._likelihood(obs, sub), 1e-300, None))
-        # Past evidence for the old hypotheses is already in log_w (normalised); rescale it
-        # to the prior mass it had.
-        base = self.log_w[:old] + math.log(1 - self.config.proposal_mass)
-        # The old posterior is P(z | h) = P(h | z) P(z) / P(h): multiply back the evidence.
-        log_ev = sum(o.log_evidence for o in self.observations)
-        self.log_w = np.concatenate([base + log_ev, log_new])
-        self.log_w -= np.logaddexp.reduce(self.log_w)
-
-    # ---- likelihood of one observation under a set of hypotheses ----
-
-    def _likelihood(self, obs: Observation, hyps: tuple[Hypothesis, ...]) -> np.ndarray:
-        fb = obs.feedback
-        feasible = np.array([h.feasible(obs.scene) for h in hyps])
-        if (isinstance(fb, PreferenceFeedback) and fb.choice == "new_scene") or (
-            isinstance(fb, StopFeedback) and fb.new_scene
-        ):
-            return np.where(feasible, NEW_SCENE_LAPSE, 1 - NEW_SCENE_LAPSE)
-        for h in hyps:
-            h.prefetch([*obs.finals, *(s for st in obs.steps or [] for s in st[:2])])
-        if isinstance(fb, PreferenceFeedback):
-            ua = utility(*judge(hyps, obs.finals[0])[::-1])
-            ub = utility(*judge(hyps, obs.finals[1])[::-1])
-            lik = preference_likelihood(fb.choice, ua, ub, obs.similarity, self.config.preference)
-        else:
-            away = first_away(hyps, obs.steps or [])
-            lik = stop_likelihood(
-                fb.stop_time, away, obs.reveal, obs.start, obs.duration, self.config.stop
-            )
-        return lik * np.where(feasible, 1 - NEW_SCENE_LAPSE, NEW_SCENE_LAPSE)
-
-    def _floor(self, obs: Observation) -> float:
-        """The likelihood a hypothesis gets from the lapse alone (to detect a collapse)."""
-        if obs.kind == "preference":
-            return self.config.preference.lapse / 3
-        m = self.config.stop
-        if obs.feedback.stop_time is None:  # type: ignore[union-attr]
-            return min(m.missed_stop, m.false_stop) + m.lapse / 2
-        span = max(obs.duration, 1e-3) + m.delay_mean + 3 * m.delay_sd
-        return (m.false_stop + m.lapse / 2) / span
-
-    # ---- Learner API ----
+    def _select(self, state: WorldState) -> Query | None:
+        c = self.config
+        outs = candidate_plans(self.hyps, self.weights, state, self.rng, top_k=c.top_k, explore=c.explore,
+                               prefixes=self.sig.shows > 1, limit=c.max_plans)
+        feasible = np.array([h.feasible(state.scene) for h in self.hyps])
+        return select_query(self.sig, self.model, self.judge, self.weights, feasible, outs,
+                            c.new_scene_error, self.rng, choose=c.choose)
 
     def design_scene(self, rng: np.random.Generator) -> Scene | None:
-        """The candidate scene (3–5 objects, sampled from the learner's rng) whose best query
-        has the largest information gain."""
+        """The candidate scene (3–5 objects, from the learner's own rng) whose best query has
+        the largest information gain."""
         best: tuple[Scene, Query] | None = None
-        for _ in range(self.config.n_scenes):
+        for _ in range(1 if self.config.choose == "random" else self.config.n_scenes):
             scene = random_scene(self.rng)
-            state = scene_state(scene, int(self.rng.integers(2**31)))
-            q = self._select(state)
+            q = self._select(WorldState(positions=layout(scene, int(self.rng.integers(2**31)))))
             if q is not None and (best is None or q.gain > best[1].gain):
                 best = (scene, q)
         self.designed = best
@@ -234,47 +165,44 @@ class BayesLearner(Learner):
         top, w = self.top()[0]
         if q is None:
             plan = top.plan(state) or []
-            q = Query([plan] * self.n_goals, 0.0)
-        return Estimate(
-            preference=top.description,
-            goals=[describe_plan(p) for p in q.plans],
-            plans=q.plans,
-            done=w >= self.config.done_threshold,
-        )
+            plans = [plan] * self.sig.shows
+            why = {"eig_nats": None, "note": "no candidate plan differs from doing nothing"}
+        else:
+            plans = q.plans
+            why = {"eig_nats": None if np.isnan(q.gain) else round(q.gain, 4), "alternatives": q.alternatives,
+                   "choose": self.config.choose, "belief_before": self._snapshot()}
+        return Estimate(z=top.description, goals=[describe_plan(p) for p in plans], plans=plans,
+                        done=w >= self.config.done_threshold, why=why)
+
+    # ---- answers ----
+
+    def _likelihood(self, obs: Observation, hyps: tuple[Hypothesis, ...], judge_) -> np.ndarray:
+        feasible = np.array([h.feasible(obs.scene) for h in hyps])
+        e = self.config.new_scene_error
+        if obs.answer.new_scene:
+            return np.where(feasible, e, 1 - e)
+        lik = self.sig.likelihood(obs.answer, obs.shown, judge_, self.model)
+        return lik * np.where(feasible, 1 - e, e)
 
     def observe(self, record: RoundRecord, trajectories: list[Trajectory]) -> str | None:
-        fb = record.feedback
-        if fb is None:
+        answer = record.answer
+        if answer is None:
             return None
-        obs = self._observation(record.scene, fb, trajectories)
-        lik = self._likelihood(obs, self.hyps)
-        w = self.weights
-        evidence = float(w @ lik)
-        obs.log_evidence = math.log(max(evidence, 1e-300))
-        collapsed = bool(lik.max() <= self.config.collapse_ratio * self._floor(obs)) and not (
-            isinstance(fb, PreferenceFeedback) and fb.choice == "new_scene"
-        )
+        texts = ([f"{k}: {describe_state(t.outcome)}" for k, t in zip("AB", trajectories, strict=False)]
+                 if self.sig.shows > 1 else
+                 [f"step {s.index + 1}: {describe_skill(s.skill)}" for t in trajectories for s in t.steps])
+        obs = Observation(record.scene, answer, list(trajectories), texts)
+        lik = self._likelihood(obs, self.hyps, self.judge)
+        evidence = self.belief.update(lik)
         self.observations.append(obs)
-        self.update(lik)
+        surprised = not answer.new_scene and evidence < self.config.surprise * float(lik.max())
         proposed: list[str] = []
-        if collapsed:
-            self.collapses += 1
         if self.llm is not None and self.proposal_calls < self.config.max_proposal_calls and (
-            collapsed or len(self.observations) == 1
+            surprised or len(self.observations) == 1
         ):
             proposed = self._propose()
-        self.log.append(
-            {
-                "round": record.index,
-                "new_scene": (isinstance(fb, PreferenceFeedback) and fb.choice == "new_scene")
-                or bool(getattr(fb, "new_scene", False)),
-                "evidence": evidence,
-                "collapsed": collapsed,
-                "proposed": proposed,
-                "top": [(h.name, round(p, 4)) for h, p in self.top(3)],
-                "entropy_bits": round(self.entropy_bits(), 3),
-            }
-        )
+        self.log.append({"round": record.index, "answer": answer.model_dump(mode="json"), "evidence": round(evidence, 6),
+                         "surprised": surprised, "proposed": proposed, **self._snapshot()})
         return None
 
     def final(self, scene: Scene, state: WorldState) -> Estimate:
@@ -282,41 +210,19 @@ class BayesLearner(Learner):
         among the plans of the hypotheses that can be shown in this scene."""
         feasible = np.array([h.feasible(scene) for h in self.hyps])
         w = self.weights * feasible
-        if w.sum() <= 0:
-            w = self.weights
-        w = w / w.sum()
+        w = w / w.sum() if w.sum() > 0 else self.weights
         outs = [predict(state, [])] + candidate_plans(
             self.hyps, w, state, self.rng, top_k=2 * self.config.top_k, explore=0,
-            prefixes=False, limit=3 * self.config.max_plans,
-        )
-        plans = [o.plan for o in outs]
+            prefixes=False, limit=3 * self.config.max_plans)
+        finals = [facts(o.traj.outcome) for o in outs]
         for h in self.hyps:
-            h.prefetch([o.final for o in outs])
-        success = np.array([float(w @ judge(self.hyps, o.final)[0]) for o in outs])
-        best = int(np.argmax(success - 1e-6 * np.array([len(p) for p in plans])))
+            h.prefetch(finals)
+        success = np.array([float(w @ judge(self.hyps, f)[0]) for f in finals])
+        best = int(np.argmax(success - 1e-6 * np.array([len(o.plan) for o in outs])))
         top = self.hyps[int(np.argmax(w))]
-        return Estimate(
-            preference=top.description,
-            goals=[describe_plan(plans[best])],
-            plans=[plans[best]],
-            done=True,
-        )
-
-    # ---- subclass hooks ----
-
-    n_goals = 1
-
-    def _select(self, state: WorldState) -> Query | None:
-        raise NotImplementedError
-
-    def _observation(self, scene: Scene, fb, trajectories: list[Trajectory]) -> Observation:
-        raise NotImplementedError
-
-    def _candidates(self, state: WorldState, prefixes: bool) -> list[Outcome]:
-        return candidate_plans(
-            self.hyps, self.weights, state, self.rng, top_k=self.config.top_k,
-            explore=self.config.explore, prefixes=prefixes, limit=self.config.max_plans,
-        )
+        plan = outs[best].plan
+        return Estimate(z=top.description, goals=[describe_plan(plan)], plans=[plan], done=True,
+                        why={"expected_success": round(float(success[best]), 4)})
 
     # ---- open-ended hypotheses ----
 
@@ -324,67 +230,39 @@ class BayesLearner(Learner):
         from activeintent.learners.bayes.proposals import propose_hypotheses
 
         self.proposal_calls += 1
-        new = propose_hypotheses(self.llm, self.top(5), self.observations)  # type: ignore[arg-type]
-        self.add_hypotheses(new)
+        try:
+            new = propose_hypotheses(self.llm, self.top(5), self.observations)  # type: ignore[arg-type]
+        except ModelError as err:
+            self.proposal_errors.append(str(err)[:300])
+            return []
+        names = {h.name for h in self.hyps}
+        new = [h for h in new if h.name not in names]
+        if not new:
+            return []
+        sub = tuple(new)
+        sub_judge = HypothesisJudge(sub)
+        log_lik = np.zeros(len(sub))
+        for obs in self.observations:
+            log_lik += np.log(np.clip(self._likelihood(obs, sub, sub_judge), 1e-300, None))
+        self.belief.add(new, self.config.proposal_mass, log_lik)
+        self.judge = HypothesisJudge(self.belief.hyps)
         return [h.description for h in new]
 
 
-class BayesPreferenceLearner(BayesLearner):
-    """bayes-preference: two plans per round, the answer A / B / can't choose."""
+class ZeroSignalLearner(BayesLearner):
+    """Baseline ``zero-signal``: the prior's best guess; it never asks anything."""
 
-    name = "bayes-preference"
-    signal = "preference"
-    n_goals = 2
+    asks = False
 
-    def _select(self, state: WorldState) -> Query | None:
-        plans = self._candidates(state, prefixes=True)
-        return best_preference_query(self.hyps, self.weights, state, plans, self.config.preference)
-
-    def _observation(self, scene, fb, trajectories):
-        if not isinstance(fb, PreferenceFeedback):
-            raise TypeError(f"bayes-preference reads preference answers, got {type(fb).__name__}")
-        if fb.choice == "new_scene":
-            return Observation("preference", scene, fb, [])
-        if len(trajectories) != 2:
-            raise ValueError(f"a preference round has two trajectories τ^a, τ^b; got {len(trajectories)}")
-        finals = [_final_state(t) for t in trajectories]
-        common = [b for b in finals[0].blocks if b in finals[1].positions]
-        pos = np.stack([[s.pos(b) for b in common] for s in finals])
-        sim = float(similarity(pos)[0, 1]) if common else 0.0
-        texts = [f"{k}: {describe_state(s)}" for k, s in zip("AB", finals, strict=True)]
-        return Observation("preference", scene, fb, [facts(s) for s in finals], similarity=sim, texts=texts)
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.name = "zero-signal"
 
 
-class BayesStopLearner(BayesLearner):
-    """bayes-stop: one plan per round, the answer a stop time (or none)."""
+class RandomQueryLearner(BayesLearner):
+    """Baseline ``random-query``: the same belief and update, queries picked at random."""
 
-    name = "bayes-stop"
-    signal = "stop"
-    n_goals = 1
-
-    def _select(self, state: WorldState) -> Query | None:
-        plans = self._candidates(state, prefixes=False)
-        return best_stop_query(self.hyps, self.weights, state, plans, self.config.stop)
-
-    def _observation(self, scene, fb, trajectories):
-        if not isinstance(fb, StopFeedback):
-            raise TypeError(f"bayes-stop reads stop answers, got {type(fb).__name__}")
-        if fb.new_scene:
-            return Observation("stop", scene, fb, [])
-        if len(trajectories) != 1:
-            raise ValueError(f"a stop round has one trajectory τ; got {len(trajectories)}")
-        traj = trajectories[0]
-        steps = [
-            (facts(s.state_before), facts(s.state_after), s.skill.block, s.ok) for s in traj.steps
-        ]
-        return Observation(
-            "stop",
-            scene,
-            fb,
-            [facts(_final_state(traj))],
-            steps=steps,
-            reveal=np.array([traj.time_of(s.reveal_tick) for s in traj.steps]),
-            start=np.array([traj.time_of(s.start_tick) for s in traj.steps]),
-            duration=traj.duration,
-            texts=[f"step {s.index + 1}: {describe_skill(s.skill)}" for s in traj.steps],
-        )
+    def __init__(self, signal, rng=None, llm=None, config: BayesConfig | None = None, hypotheses=None):
+        config = (config or BayesConfig()).model_copy(update={"choose": "random"})
+        super().__init__(signal, rng, llm, config, hypotheses)
+        self.name = f"random-query-{self.signal}"

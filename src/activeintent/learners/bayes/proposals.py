@@ -9,15 +9,16 @@ batches — one sandbox call judges every state a query needs.
 
 from __future__ import annotations
 
+import re
 import textwrap
 from typing import Protocol
 
 import numpy as np
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, Field, field_validator
 
 from activeintent.learners.bayes.facts import Facts, facts
 from activeintent.learners.bayes.hypotheses import Hypothesis
-from activeintent.llm.base import ChatModel, Message, ModelError
+from activeintent.llm.base import ChatModel, Message
 from activeintent.world import WorldState
 from activeintent.world.colors import WARM_COLORS
 from activeintent.world.scene import color_of
@@ -26,6 +27,14 @@ from activeintent.world.scene import color_of
 class ProposedIntention(BaseModel):
     description: str = Field(min_length=3, max_length=300)
     predicate: str = Field(min_length=1, max_length=3000, description="body of def holds(world)")
+
+    @field_validator("description")
+    @classmethod
+    def _words(cls, text: str) -> str:
+        # A small base model sometimes answers "..." or a bare symbol: that is no intention.
+        if len(re.findall(r"[A-Za-z]{2,}", text)) < 3:
+            raise ValueError("a proposed intention must be a sentence of at least three words")
+        return text
 
 
 class Proposals(BaseModel):
@@ -170,18 +179,16 @@ def propose_hypotheses(
         observations=_summarise(observations),
         count=count,
     )
-    try:
-        got = llm.structured([Message(role="user", content=prompt)], Proposals, max_tokens=700)
-    except ModelError:
-        return []
+    # A ModelError propagates: the learner records it (a proposal that never came is not "0 calls").
+    got = llm.structured([Message(role="user", content=prompt)], Proposals, max_tokens=700)
     runner = runner or SandboxRunner()
     probes = [f for obs in observations for f in obs.finals][:6]
     if not probes:
         rng = np.random.default_rng(0)
         from activeintent.learners.bayes.hypotheses import random_scene
-        from activeintent.learners.bayes.query import scene_state
+        from activeintent.world import layout
 
-        probes = [facts(scene_state(random_scene(rng), 0))]
+        probes = [facts(WorldState(positions=layout(random_scene(rng), 0)))]
     out = []
     for p in got.hypotheses[:count]:
         h = compile_proposal(p, runner, probes)

@@ -1,17 +1,28 @@
-"""τ: the per-tick log of an execution. Pure data; frames are rendered from it on demand."""
+"""τ: the per-tick log of an execution, pure data shared by every env, user and learner.
+
+Frames are not part of τ: an env that can draw (PyBullet) attaches a ``renderer`` so that
+learners needing images (I_0, I_b, I_s) ask ``traj.frame(t)`` without importing ``sim/``.
+"""
 
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from pydantic import TypeAdapter
 
-from activeintent.world import Scene, Skill, WorldState
+from activeintent.world.scene import Scene
+from activeintent.world.skills import Skill
+from activeintent.world.state import WorldState
 
 _SKILL = TypeAdapter(Skill)
+
+
+class RenderUnavailable(RuntimeError):
+    """Asked for a frame of τ that no renderer can draw."""
 
 
 @dataclass
@@ -78,6 +89,9 @@ class Trajectory:
     steps: list[StepRecord] = field(default_factory=list)
     initial_state: WorldState | None = None
     final_state: WorldState | None = None
+    renderer: Callable[[Trajectory, float, tuple[int, int]], np.ndarray] | None = field(
+        default=None, repr=False, compare=False
+    )
 
     @property
     def n_ticks(self) -> int:
@@ -120,11 +134,32 @@ class Trajectory:
             }
         )
 
-    def frame(self, t: float, size: tuple[int, int] = (240, 240)) -> np.ndarray:
-        """RGB image (H, W, 3) uint8 of the scene at time t, rendered from the log."""
-        from activeintent.sim.render import render_frame
+    @property
+    def outcome(self) -> WorldState:
+        """The state τ ends in: the logged final state, else the last tick, else the start."""
+        if self.final_state is not None:
+            return self.final_state
+        if self.steps:
+            return self.steps[-1].state_after
+        if self.n_ticks > 0:
+            return self.state_at(self.duration)
+        if self.initial_state is not None:
+            return self.initial_state
+        raise ValueError("the trajectory has no states (no ticks, no initial or final state)")
 
-        return render_frame(self, t, size=size)
+    @property
+    def moved_anything(self) -> bool:
+        """False for an empty or wholly failed execution: nothing was shown to the user."""
+        return any(s.ok for s in self.steps)
+
+    def frame(self, t: float, size: tuple[int, int] = (240, 240)) -> np.ndarray:
+        """RGB image (H, W, 3) uint8 of the scene at time t, drawn by the env's renderer."""
+        if self.renderer is None:
+            raise RenderUnavailable(
+                "this trajectory comes from an env that cannot draw (e.g. --env symbolic); "
+                "use --env pybullet for learners that need images"
+            )
+        return self.renderer(self, t, size)
 
     def save(self, path: str | Path) -> Path:
         """Write ``path`` (.npz): arrays plus a JSON header; readable by :meth:`load`."""

@@ -1,0 +1,45 @@
+"""The Env protocol: ``reset(scene, seed) -> state``, ``execute(plan) -> τ``, ``close()``."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Protocol, runtime_checkable
+
+from activeintent.registry import Registry
+from activeintent.world import Scene, Skill, WorldState
+from activeintent.world.trajectory import Trajectory
+
+
+@runtime_checkable
+class Env(Protocol):
+    name: str
+    renders: bool  # can its trajectories be drawn (frames for MLLMs, videos for people)?
+
+    def reset(self, scene: Scene, seed: int) -> WorldState:
+        """Lay ``scene`` out from ``seed``; returns the initial state."""
+
+    def execute(self, plan: Sequence[Skill]) -> Trajectory:
+        """Run ``plan`` from the current state; returns its log τ."""
+
+    def close(self) -> None: ...
+
+
+ENVS: Registry[Env] = Registry("env")
+
+
+@ENVS.register("symbolic", help="the symbolic world model: fast, no physics, no images")
+def _symbolic() -> Env:
+    from activeintent.envs.symbolic import SymbolicEnv
+
+    return SymbolicEnv()
+
+
+@ENVS.register("pybullet", help="PyBullet physics with a Panda arm; renders frames")
+def _pybullet() -> Env:
+    from activeintent.sim.env import PyBulletEnv
+
+    return PyBulletEnv()
+
+
+def make_env(name: str) -> Env:
+    return ENVS.make(name)

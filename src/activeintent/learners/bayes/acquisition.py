@@ -1,0 +1,87 @@
+"""Acquisition: which query to ask, by expected information gain (or at random, the baseline).
+
+For a query q (the trajectories it would show) the signal's observation model gives
+P(h | z, q) for every hypothesis z; with the answer "new scene" appended (likely exactly when
+the scene cannot show z, up to the learner's assumed error rate ε_ns)::
+
+    EIG(q) = H[Σ_z w_z P(h | z, q)] − Σ_z w_z H[P(h | z, q)]
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydantic import BaseModel
+
+from activeintent.learners.bayes.candidates import Outcome
+from activeintent.signals import Judge, Signal
+from activeintent.world import describe_plan
+
+
+def _entropy(p: np.ndarray) -> np.ndarray:
+    return -(p * np.log(np.clip(p, 1e-300, None))).sum(axis=-1)
+
+
+def eig(weights: np.ndarray, probs: np.ndarray) -> float:
+    """EIG in nats from P(h | z): probs [H, O], weights [H]."""
+    return float(_entropy(weights @ probs) - weights @ _entropy(probs))
+
+
+def with_new_scene(probs: np.ndarray, feasible: np.ndarray, error: float) -> np.ndarray:
+    """Append the answer "new scene" to P(h | z): P = 1 − ε where z cannot be shown, ε where it can."""
+    p_new = np.where(feasible, error, 1 - error)[:, None]
+    return np.concatenate([probs * (1 - p_new), p_new], axis=1)
+
+
+@dataclass
+class Query:
+    """The trajectories to show (as plans) and why: the EIG of this query and the best others."""
+
+    outcomes: list[Outcome]
+    gain: float  # nats
+    alternatives: list[dict] = field(default_factory=list)
+
+    @property
+    def plans(self):
+        return [o.plan for o in self.outcomes]
+
+
+def select_query(
+    signal: Signal,
+    model: BaseModel,
+    judge: Judge,
+    weights: np.ndarray,
+    feasible: np.ndarray,
+    outs: list[Outcome],
+    new_scene_error: float,
+    rng: np.random.Generator,
+    choose: str = "eig",
+    max_queries: int = 700,
+) -> Query | None:
+    """The query (``signal.shows`` distinct outcomes) with the largest EIG; ``choose="random"``
+    picks uniformly among the candidates instead (same planner, same belief update)."""
+    combos = list(itertools.combinations(range(len(outs)), signal.shows))
+    if not combos:
+        return None
+    if len(combos) > max_queries:  # keep selection time bounded: a seeded subset
+        keep = rng.choice(len(combos), size=max_queries, replace=False)
+        combos = [combos[i] for i in sorted(keep)]
+    if choose == "random":
+        pick = combos[int(rng.integers(len(combos)))]
+        return Query([outs[i] for i in pick], float("nan"))
+    gains = np.empty(len(combos))
+    for n, combo in enumerate(combos):
+        probs = signal.predictive([outs[i].traj for i in combo], judge, model)
+        # Among (near-)equal gains prefer short plans: they are quicker to watch.
+        gains[n] = eig(weights, with_new_scene(probs, feasible, new_scene_error)) - 1e-4 * sum(
+            len(outs[i].plan) for i in combo)
+    order = np.argsort(-gains, kind="stable")
+    best = combos[order[0]]
+    alternatives = [
+        {"plans": [describe_plan(outs[i].plan) for i in combos[j]],
+         "eig_nats": round(float(gains[j]), 4)}
+        for j in order[1:4]
+    ]
+    return Query([outs[i] for i in best], float(gains[order[0]]), alternatives)

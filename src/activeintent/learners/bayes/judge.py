@@ -1,0 +1,82 @@
+"""The :class:`activeintent.signals.Judge` of the hypothesis space: every z judges at once."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from activeintent.learners.bayes.facts import Facts, facts
+from activeintent.learners.bayes.hypotheses import Hypothesis
+from activeintent.world import WorldState
+from activeintent.world.trajectory import Trajectory
+
+
+def judge(hyps: tuple[Hypothesis, ...], f: Facts) -> tuple[np.ndarray, np.ndarray]:
+    """(satisfied, score) of one state under every hypothesis (memoised on the facts)."""
+    key = ("judge", id(hyps))
+    got = f.memo.get(key)
+    if got is None:
+        sat = np.fromiter((h.holds_f(f) for h in hyps), bool, len(hyps))
+        score = np.fromiter((h.score_f(f) for h in hyps), float, len(hyps))
+        got = f.memo[key] = (sat, score)
+    return got
+
+
+def utility(score: np.ndarray, sat: np.ndarray) -> np.ndarray:
+    """u = (score + 1[satisfied]) / 2 ∈ [0, 1], elementwise."""
+    return 0.5 * (np.clip(score, 0.0, 1.0) + sat.astype(float))
+
+
+Steps = list[tuple[Facts, Facts, str, bool]]
+
+
+def trajectory_steps(traj: Trajectory) -> Steps:
+    """(facts before, facts after, moved block, executed ok) per step of τ."""
+    return [(facts(s.state_before), facts(s.state_after), s.skill.block, s.ok) for s in traj.steps]
+
+
+def first_away(hyps: tuple[Hypothesis, ...], steps: Steps) -> np.ndarray:
+    """Per hypothesis, the index of the first step that moves away from it (-1: none).
+    A failed step counts only when it made things worse (its score dropped)."""
+    out = np.full(len(hyps), -1)
+    for k, (fb, fa, block, ok) in enumerate(steps):
+        todo = np.flatnonzero(out < 0)
+        if not len(todo):
+            break
+        if fb is fa:
+            continue
+        _, sb = judge(hyps, fb)
+        _, sa = judge(hyps, fa)
+        drop = sa < sb - 1e-9
+        for i in todo:
+            if drop[i] or (ok and hyps[i].moved_off(fb, fa, block)):
+                out[i] = k
+    return out
+
+
+class HypothesisJudge:
+    """Judges outcomes under every hypothesis of H (n = |H|)."""
+
+    def __init__(self, hyps: tuple[Hypothesis, ...]):
+        self.hyps = hyps
+        self.size = len(hyps)
+        self._away: dict[int, tuple[Trajectory, np.ndarray]] = {}
+
+    def utility(self, state: WorldState) -> np.ndarray:
+        f = facts(state)
+        for h in self.hyps:
+            h.prefetch([f])
+        sat, score = judge(self.hyps, f)
+        return utility(score, sat)
+
+    def first_away(self, traj: Trajectory) -> np.ndarray:
+        hit = self._away.get(id(traj))
+        if hit is not None and hit[0] is traj:
+            return hit[1]
+        steps = trajectory_steps(traj)
+        for h in self.hyps:
+            h.prefetch([f for st in steps for f in st[:2]])
+        away = first_away(self.hyps, steps)
+        if len(self._away) > 4096:
+            self._away.clear()
+        self._away[id(traj)] = (traj, away)  # keeps τ alive so its id is not reused
+        return away

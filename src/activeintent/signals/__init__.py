@@ -1,0 +1,12 @@
+"""Signals h as plug-ins: what a query shows, which answers a person can give, how a simulated
+user gives one, how likely an answer is under a hypothesis, and how the web page reads it.
+
+Every signal also allows the answer "new scene" (this scene cannot show what I want); it is
+one signal like any other answer. Built in: ``preference`` (A / B / can't choose between two
+trajectories) and ``stop`` (the time the person pressed stop, or none). Add your own with
+``SIGNALS.register("name", YourSignal)`` — see ``examples/my_signal.py``.
+"""
+
+from activeintent.signals.base import SIGNALS, Answer, Judge, Signal, get_signal
+
+__all__ = ["SIGNALS", "Answer", "Judge", "Signal", "get_signal"]

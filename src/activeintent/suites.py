@@ -1,0 +1,57 @@
+"""Benchmark suites of hidden intentions: ``paper`` (the paper's four), ``library`` (the other
+built-in intentions) and ``heldout`` (written blind, before any learner change, in
+``bench/heldout.py``; reported separately). Names of every suite resolve everywhere an
+intention name is accepted.
+"""
+
+from __future__ import annotations
+
+from activeintent.intentions.base import Intention
+from activeintent.intentions.registry import (
+    INTENTION_NAMES,
+    PAPER_INTENTIONS,
+    IntentionError,
+    get_intention,
+    resolve_intention,
+)
+
+SUITE_NAMES = ("paper", "library", "heldout")
+
+
+def _heldout() -> dict[str, Intention]:
+    from activeintent.bench.heldout import heldout_intentions
+
+    return {it.name: it for it in heldout_intentions()}
+
+
+def suite(name: str) -> list[str]:
+    """Intention names of a suite."""
+    if name == "paper":
+        return list(PAPER_INTENTIONS)
+    if name == "library":
+        return [n for n in INTENTION_NAMES if n not in PAPER_INTENTIONS]
+    if name == "heldout":
+        return list(_heldout())
+    raise ValueError(f"Unknown suite {name!r}; valid suites: {', '.join(SUITE_NAMES)}.")
+
+
+def suite_of(intention: str) -> str:
+    """The suite an intention name belongs to ('file' for path.py:NAME)."""
+    if ".py:" in intention:
+        return "file"
+    if intention in PAPER_INTENTIONS:
+        return "paper"
+    return "library" if intention in INTENTION_NAMES else "heldout"
+
+
+def resolve(name: str | None, intention_file: str | None = None) -> Intention:
+    """``--intention NAME`` (any suite) or ``--intention-file path.py:NAME``."""
+    if name and not intention_file and name not in INTENTION_NAMES:
+        held = _heldout()
+        if name in held:
+            return held[name]
+        try:
+            return get_intention(name)
+        except IntentionError as err:
+            raise IntentionError(f"{err} Held-out intentions: {', '.join(held)}.") from None
+    return resolve_intention(name, intention_file)
