@@ -159,6 +159,22 @@ def test_parse_known_answers(text, expected):
 
 
 @pytest.mark.parametrize(
+    ("phrase", "xy"),
+    [
+        ("at the top left corner", (-0.25, -0.25)),
+        ("at the top side", (0.0, -0.25)),
+        ("at the left side", (-0.25, -0.5)),
+        ("in the middle", (0.0, -0.5)),
+        ("at the bottom right corner", (0.25, -0.75)),
+    ],
+)
+def test_named_positions_are_the_table_layout(phrase, xy):
+    """The parsed position names the place of the Code-as-Policies table layout the user means."""
+    (step,) = parse_instruction(f"put the red block {phrase}", SCENE)
+    assert TABLE_POSITIONS[step.position] == xy
+
+
+@pytest.mark.parametrize(
     ("text", "expected"),
     [
         ("stack the green block on the red block", [PutOn(block="green block", target="red block")]),
