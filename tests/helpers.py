@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from activeintent.sim.trajectory import StepRecord, Trajectory
+from activeintent.world.trajectory import StepRecord, Trajectory
 from activeintent.world import Scene, Skill, WorldState, apply_skill, layout
 
 STEP_TICKS = 30  # ticks per skill; with dt = 0.1 s a skill takes 3 s

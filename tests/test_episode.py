@@ -1,4 +1,5 @@
-"""Full episodes: real simulator, real simulated users, scripted and embedded models."""
+"""The one episode loop under the honest protocol: every answer counts, a fixed budget,
+success after every signal on test scenes independent of the hidden intention."""
 
 from __future__ import annotations
 
@@ -7,119 +8,172 @@ import json
 import pytest
 
 from activeintent.act.base import make_executor
-from activeintent.episode import Episode, EpisodeConfig, EpisodeSeeds, read_rounds
-from activeintent.intentions.registry import get_intention
-from activeintent.learners.registry import SIGNAL, make_learner
+from activeintent.envs.symbolic import SymbolicEnv
+from activeintent.episode import Episode, EpisodeConfig
+from activeintent.learners.registry import LearnerContext, get_method
 from activeintent.llm.scripted import ScriptedModel
-from activeintent.sim.env import TabletopEnv
-from activeintent.users.simulated import UserConfig, make_user
+from activeintent.protocol import trial_seeds
+from activeintent.records import read_rounds
+from activeintent.runner import RunOptions, build_episode
+from activeintent.signals import get_signal
+from activeintent.suites import resolve
+from activeintent.users.simulated import SimulatedUser, user_profile
 
 
-@pytest.fixture(scope="module")
-def env():
-    with TabletopEnv() as e:
-        yield e
+class ScriptedUser:
+    """Gives the answers it is handed, in order (then repeats the last)."""
+
+    def __init__(self, signal: str, answers: list[dict]):
+        self.sig = get_signal(signal)
+        self.answers = [self.sig.parse(a) for a in answers]
+        self.asked = 0
+
+    def respond(self, scene, trajectories):
+        self.asked += 1
+        return self.answers[min(self.asked - 1, len(self.answers) - 1)]
+
+
+def bayes_episode(method: str, user, budget: int, new_scene: str = "counted", seed: int = 4, out=None) -> Episode:
+    learner = get_method(method)(LearnerContext(seed=seed))
+    return Episode(learner, resolve("stack"), user, make_executor("parse"), SymbolicEnv(),
+                   EpisodeConfig(budget=budget, seed=seed, test_scenes=10, new_scene=new_scene), out_dir=out)
+
+
+@pytest.mark.parametrize("method,answers", [
+    ("bayes-stop", [{"new_scene": True}, {"stop_time": 1.5}, {"stop_time": None}, {"new_scene": True}]),
+    ("bayes-preference", [{"choice": "A"}, {"new_scene": True}, {"choice": "B"}, {"choice": "cant_choose"}]),
+])
+def test_every_answer_is_one_signal(method, answers):
+    user = ScriptedUser("stop" if method == "bayes-stop" else "preference", answers)
+    result = bayes_episode(method, user, budget=4).run()
+    assert result.error is None
+    assert user.asked == result.rounds_used == result.signals_used == 4
+    assert sum(result.answers.values()) == 4 and result.answers["new_scene"] == sum(a.get("new_scene", False) for a in answers)
+    assert len(result.success_at) == 5 and all(s is not None for s in result.success_at)
+
+
+def test_free_rule_does_not_count_new_scene_answers_and_says_so():
+    answers = [{"new_scene": True}, {"new_scene": True}, {"stop_time": None}, {"stop_time": None}]
+    result = bayes_episode("bayes-stop", ScriptedUser("stop", answers), budget=2, new_scene="free").run()
+    assert result.rounds_used == 4 and result.signals_used == 2 and result.new_scene == "free"
+    assert len(result.success_at) == 3
+
+
+def test_budget_is_fixed_even_when_the_learner_says_done():
+    result = build_episode(RunOptions(method="bayes-stop", intention="stack", env="symbolic", llm="none",
+                                      user="exact", video="none", budget=6, seed=2)).run()
+    assert result.signals_used == result.rounds_used == 6
+
+
+def test_test_scenes_are_the_same_for_every_method_and_intention_of_a_trial():
+    scenes = {}
+    for intention in ("stack", "color-match", "one-bowl"):
+        seed, test_seed = trial_seeds(7, intention, trial=1)
+        for method in ("bayes-stop", "zero-signal"):
+            r = build_episode(RunOptions(method=method, intention=intention, env="symbolic", llm="none",
+                                         video="none", budget=1, seed=seed, test_seed=test_seed)).run()
+            scenes[(intention, method)] = [(t.scene, t.layout_seed) for t in r.tests]
+    first = next(iter(scenes.values()))
+    assert len(first) >= 10 and all(v == first for v in scenes.values())
+    assert trial_seeds(7, "stack", 1)[1] != trial_seeds(7, "stack", 2)[1]
+
+
+def test_the_test_scenes_tell_a_learner_nothing_about_the_intention():
+    """Same trial, two intentions: a learner that asks nothing answers identically on every
+    test scene — nothing of the hidden intention reached it through the scenes."""
+    answers = {}
+    for intention in ("stack", "color-match"):
+        _, test_seed = trial_seeds(0, intention, trial=0)
+        r = build_episode(RunOptions(method="zero-signal", intention=intention, env="symbolic", llm="none",
+                                     video="none", seed=11, test_seed=test_seed)).run()
+        answers[intention] = [(t.scene, t.plan, t.z) for t in r.tests]
+        assert r.test_excluded == sum(not t.feasible for t in r.tests)
+    assert answers["stack"] == answers["color-match"]
+
+
+def test_infeasible_test_scenes_are_excluded_from_scoring_only():
+    r = build_episode(RunOptions(method="bayes-stop", intention="color-match", env="symbolic", llm="none",
+                                 video="none", budget=1, seed=5)).run()
+    feasible = [t for t in r.tests if t.feasible]
+    assert 0 < r.test_excluded < r.test_scenes == len(r.tests)
+    assert r.success == pytest.approx(sum(t.success for t in feasible) / len(feasible))
+
+
+def test_same_seed_same_episode(tmp_path):
+    def once(out):
+        build_episode(RunOptions(method="bayes-preference", intention="color-mismatch", env="symbolic", llm="none",
+                                 video="none", budget=3, seed=9), out).run()
+        rounds = read_rounds(out / "rounds.jsonl")
+        for r in rounds:
+            r.pop("timing")
+        return rounds, json.loads((out / "summary.json").read_text())["success_at"]
+
+    assert once(tmp_path / "a") == once(tmp_path / "b")
+
+
+def test_round_records_explain_the_query(tmp_path):
+    build_episode(RunOptions(method="bayes-preference", intention="stack", env="symbolic", llm="none",
+                             video="none", budget=2, seed=1), tmp_path).run()
+    rounds = read_rounds(tmp_path / "rounds.jsonl")
+    for r in rounds:
+        assert r["format"] == 2 and r["labels"] == ["A", "B"]
+        if not r["answer"]["new_scene"]:
+            assert r["why"]["eig_nats"] > 0 and len(r["why"]["alternatives"]) == 3
+            assert all(a["eig_nats"] <= r["why"]["eig_nats"] + 1e-3 for a in r["why"]["alternatives"])
+            assert r["why"]["belief_before"]["entropy_bits"] > 0
 
 
 def scripted_answers(messages, schema):
-    """A plausible model: always the colour-match intention, goals built from the scene's objects."""
+    """A model that states colour-match and names goals that cannot be grounded in round 1."""
     title = (schema or {}).get("title", "")
-    text = messages[-1].text
     if title == "IntentionAnswer":
         return {"preference": "Each block goes into the bowl of its own colour.", "done": False}
     if title == "SceneChoice":
         return {"objects": ["red block", "blue block", "red bowl", "blue bowl"]}
     if title == "GoalsAnswer":
-        objects = text.split("Objects you may use: ")[1].split(".\n")[0].split(", ")
-        blocks = [o for o in objects if o.endswith("block")]
-        bowls = [o for o in objects if o.endswith("bowl")]
-        same = [f"put the {b} in the {b.replace('block', 'bowl')}" for b in blocks if b.replace("block", "bowl") in bowls]
-        other = [f"put the {b} in the {bowls[0]}" for b in blocks[:1]]
-        goals = [", then ".join(same or other), ", then ".join(other)]
-        return dict(zip(schema["properties"], goals, strict=False))
+        return dict.fromkeys(schema["properties"], "put the red block in the blue bowl")
     if title == "RetrievalAnswer":
-        return {"retrieved": "The user stopped the robot as it moved a block into a bowl of another colour."}
+        return {"retrieved": "the robot put a block in a bowl of another colour"}
+    if title == "Plan":
+        return {"steps": []}
     raise AssertionError(title)
 
 
-def run(method, env, tmp_path, model, intention="color-match", rounds=2, seed=3, track_progress=True,
-        design_scenes=True, goal_retries=1):
-    seeds = EpisodeSeeds.from_seed(seed)
-    it = get_intention(intention)
-    user = make_user(SIGNAL[method], it, UserConfig(), seed=seeds.user)
-    learner = make_learner(method, llm=model, seed=seeds.learner, design_scenes=design_scenes)
+def test_an_ungroundable_goal_then_no_stop_is_a_failed_execution_not_approval(tmp_path):
+    model = ScriptedModel(respond=scripted_answers, accepts_images=False)
+    learner = get_method("mllm-llm")(LearnerContext(llm=model))
+    user = ScriptedUser("stop", [{"stop_time": None}])
+    # An executor that can ground nothing: every y fails to become motion.
+    executor = make_executor("parse")
+    learner_goal = "make the table look nice"
+    episode = Episode(learner, resolve("color-match"), user, executor, SymbolicEnv(),
+                      EpisodeConfig(budget=1, test_scenes=1, max_goal_retries=0), out_dir=tmp_path)
+    learner._goals = lambda *a, **k: [learner_goal]  # noqa: SLF001 - force an ungroundable y
+    episode.run()
+    (r,) = read_rounds(tmp_path / "rounds.jsonl")
+    assert r["executed"] == [False] and r["failures"][0]
+    assert "accepted" not in (r["retrieved"] or "") and "nothing moved" in r["retrieved"]
+
+
+def test_model_calls_are_counted_when_built_from_python():
+    model = ScriptedModel(respond=scripted_answers, accepts_images=False)
+    learner = get_method("preference")(LearnerContext(llm=model))
+    user = SimulatedUser(resolve("color-match"), "preference", user_profile("exact"), rng=0)
+
     def usage():
         t = model.usage.snapshot()
         return t.calls, t.prompt_tokens, t.completion_tokens
 
-    episode = Episode(learner, it, user, make_executor("plan", model=model), env,
-                      EpisodeConfig(rounds=rounds, seed=seed, save_videos=False, track_progress=track_progress,
-                                    max_goal_retries=goal_retries), tmp_path,
-                      usage=usage)
-    return episode.run()
-
-
-@pytest.mark.parametrize("method", ["preference", "mllm", "mllm-llm"])
-def test_paper_learner_full_episode_with_scripted_model(method, env, tmp_path):
-    model = ScriptedModel(respond=scripted_answers, accepts_images=False)
-    result = run(method, env, tmp_path, model)
-    assert result.error is None
-    assert result.signals_used == 2
-    assert result.success  # the scripted model states the hidden intention
-    summary = json.loads((tmp_path / "summary.json").read_text())
-    for key in ("method", "intention", "seed", "success", "rounds_used", "final_preference", "final_goal",
-                "llm_calls", "prompt_tokens", "completion_tokens", "wall_s", "retriever"):
-        assert key in summary
-    rounds = read_rounds(tmp_path / "rounds.jsonl")
-    assert len(rounds) == result.rounds_used
-    assert all(r["calls"] and r["feedback"]["kind"] == SIGNAL[method] for r in rounds)
-    # Round 2's intention prompt conditions on round 1's z, y and h (and r for mllm-llm).
-    eq = "eq1_intention" if method == "preference" else "eq5_intention"
-    second = next(c for c in rounds[1]["calls"] if c["template"] == eq and not c.get("probe"))["prompt"]
-    first = rounds[0]
-    assert first["preference"] in second and first["goals"][0] in second and "h_1:" in second
-    if method == "mllm-llm":
-        assert first["retrieved"] and first["retrieved"] in second
-    assert result.retriever == (None if method == "preference" else "symbolic")
-    assert len(result.per_round_success) == len(rounds)
-
-
-def test_same_seed_same_episode_with_scripted_model(env, tmp_path):
-    a = run("mllm-llm", env, tmp_path / "a", ScriptedModel(respond=scripted_answers, accepts_images=False))
-    b = run("mllm-llm", env, tmp_path / "b", ScriptedModel(respond=scripted_answers, accepts_images=False))
-    assert strip_timing(read_rounds(tmp_path / "a" / "rounds.jsonl")) == strip_timing(read_rounds(tmp_path / "b" / "rounds.jsonl"))
-    assert [t.model_dump(exclude={"calls"}) for t in a.tests] == [t.model_dump(exclude={"calls"}) for t in b.tests]
-    assert a.llm_calls == b.llm_calls > 0
-
-
-def strip_timing(rounds: list[dict]) -> list[dict]:
-    out = []
-    for r in rounds:
-        r = dict(r)
-        r.pop("timing", None)
-        r["calls"] = [{k: v for k, v in c.items() if k != "s"} for c in r["calls"]]
-        out.append(r)
-    return out
+    result = Episode(learner, resolve("color-match"), user, make_executor("parse"), SymbolicEnv(),
+                     EpisodeConfig(budget=1, test_scenes=2), usage=usage).run()
+    assert result.llm_calls == model.usage.snapshot().calls > 0
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("method", ["preference", "mllm", "mllm-llm"])
-def test_paper_learner_full_episode_with_embedded_model(method, env, tmp_path):
-    from activeintent.llm.registry import load_model
-
-    model = load_model("embedded", cache_path=tmp_path / "cache.sqlite", cache_mode="record")
-    # One round; only mllm-llm designs its scene (the other two save that call on this slow model).
-    fast = dict(rounds=1, track_progress=False, design_scenes=method == "mllm-llm", goal_retries=0)
-    result = run(method, env, tmp_path / "run", model, **fast)
-    assert result.error is None, result.error
-    assert result.llm_calls > 0 and result.rounds_used >= 1
-    rounds = read_rounds(tmp_path / "run" / "rounds.jsonl")
-    assert rounds and all(c.get("answer") or c.get("unusable") for r in rounds for c in r["calls"])
-    if method != "mllm-llm":
-        return
-    # Warm cache: the same seed makes identical calls and gets identical answers, no model work.
-    before = model.usage.snapshot()
-    again = run(method, env, tmp_path / "again", model, **fast)
-    assert model.usage.diff(before).cache_misses == 0
-    assert strip_timing(read_rounds(tmp_path / "again" / "rounds.jsonl")) == strip_timing(rounds)
-    assert again.final_goal == result.final_goal
+def test_physics_scoring_at_the_end_reports_agreement(tmp_path):
+    r = build_episode(RunOptions(method="bayes-stop", intention="stack", env="pybullet", llm="none",
+                                 video="final", budget=1, seed=3, test_scenes=3), tmp_path).run()
+    scored = [t for t in r.tests if t.feasible]
+    assert all(t.success_physics is not None for t in scored)
+    assert r.physics_disagreements == sum(t.success != t.success_physics for t in scored)
+    assert r.env == "pybullet" and (tmp_path / "final.gif").stat().st_size > 0

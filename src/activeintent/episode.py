@@ -40,6 +40,7 @@ from activeintent.protocol import (
     sample_round_scene,
     sample_test_scene,
 )
+from activeintent.records import EpisodeRecorder
 from activeintent.signals import Answer
 from activeintent.world import Scene, Skill, WorldState, apply_plan, describe_plan, layout
 from activeintent.world.trajectory import Trajectory
@@ -203,6 +204,8 @@ class Episode:
         self.model_time = model_time or (lambda: 0.0)
         self.extra_config = extra_config or {}
         self.out = Path(out_dir) if out_dir else None
+        if self.out is not None and not any(isinstance(o, EpisodeRecorder) for o in self.observers):
+            self.observers.insert(0, EpisodeRecorder(self.out))
         self.seeds = EpisodeSeeds.from_seed(self.config.seed, self.config.test_seed)
         self.clock = _Clock()
 

@@ -116,7 +116,6 @@ def build_episode(
     from activeintent.act.base import make_executor
     from activeintent.envs import make_env
     from activeintent.learners.registry import LearnerContext, get_method
-    from activeintent.records import EpisodeRecorder
     from activeintent.suites import resolve as resolve_intention
     from activeintent.users.simulated import SimulatedUser, user_profile
 
@@ -139,8 +138,6 @@ def build_episode(
                            test_scenes=options.test_scenes, new_scene=options.new_scene, curve=options.curve,
                            video=options.video, stop_when_done=options.stop_when_done)
     observers = list(observers or [])
-    if out_dir is not None:
-        observers.insert(0, EpisodeRecorder(out_dir))
     return Episode(learner, intention, user, executor, env or make_env(options.env), config, observers,
                    usage=models.usage, model_time=models.model_time,
                    extra_config={"options": options.model_dump(mode="json")}, out_dir=out_dir)

@@ -1,4 +1,5 @@
-"""The benchmark: tiny runs complete, report the right rows, resume after a kill, reproduce."""
+"""The benchmark: tiny runs complete under the protocol, report intervals and baselines,
+resume after a kill, refuse mixed settings, reproduce, and take plug-in signals."""
 
 from __future__ import annotations
 
@@ -13,16 +14,20 @@ from pathlib import Path
 import pytest
 
 from activeintent.bench.report import wilson, write_report
-from activeintent.bench.runner import BenchOptions, WorkItem, episode_seed, read_results, run_bench
+from activeintent.bench.runner import BenchOptions, run_bench
+from activeintent.protocol import trial_seeds
+from activeintent.records import read_results
 from activeintent.runner import RunOptions
 
-METHODS = ["bayes-preference", "bayes-stop"]
+ROOT = Path(__file__).resolve().parents[2]
+METHODS = ["bayes-stop", "zero-signal"]
 INTENTIONS = ["stack", "color-match"]
+PROTOCOL = ("env", "user_preset", "budget", "new_scene", "prior", "test_scenes")
 
 
-def tiny(jobs: int = 1) -> BenchOptions:
+def tiny(jobs: int = 1, **run) -> BenchOptions:
     return BenchOptions(methods=METHODS, intentions=INTENTIONS, trials=1, seed=5, jobs=jobs,
-                        run=RunOptions(rounds=2, save_videos=False, llm="none"))
+                        run=RunOptions(budget=2, llm="none", env="symbolic", video="none", **run))
 
 
 def test_wilson_interval_matches_known_values():
@@ -31,33 +36,32 @@ def test_wilson_interval_matches_known_values():
     assert wilson(0, 5)[0] == 0.0 and wilson(5, 5)[1] == 1.0
 
 
-def test_trial_seeds_are_shared_by_methods_and_differ_by_trial():
-    a = WorkItem(method="bayes-stop", intention="stack", trial=0)
-    b = WorkItem(method="preference", intention="stack", trial=0)
-    assert episode_seed(5, a.intention, a.trial) == episode_seed(5, b.intention, b.trial)
-    assert episode_seed(5, "stack", 0) != episode_seed(5, "stack", 1)
+def test_trial_seeds():
+    assert trial_seeds(5, "stack", 0)[1] == trial_seeds(5, "color-match", 0)[1]  # test scenes: per trial only
+    assert trial_seeds(5, "stack", 0)[0] != trial_seeds(5, "color-match", 0)[0]
+    assert trial_seeds(5, "stack", 0) != trial_seeds(5, "stack", 1)
 
 
-def test_tiny_bench_completes_with_report_and_reproduces(tmp_path):
+def test_tiny_bench_records_the_protocol_and_reports_intervals_and_baselines(tmp_path):
     records = run_bench(tiny(), tmp_path / "one")
     assert len(records) == 4 and not any(r.get("error") for r in records)
-    assert {(r["method"], r["intention"]) for r in records} == {(m, i) for m in METHODS for i in INTENTIONS}
     for r in records:
-        assert r["signals_used"] <= 2 and len(r["per_round_success"]) == r["rounds_used"]
-        assert set(r["time_split"]) == {"sim_s", "render_s", "model_s"}
-    report = write_report(records, METHODS, INTENTIONS, tmp_path / "one", {"trials": 1}).read_text()
-    rows = [line for line in report.splitlines() if line.startswith("| bayes-")]
-    assert [r.split(" | ")[0] for r in rows] == ["| bayes-preference", "| bayes-stop"]
-    assert "(paper)" in report and "| mllm-llm (paper) | 0.4 | 0.8 | 0.60 |" in report  # columns that were run
+        assert r["format"] == 2 and all(k in r for k in PROTOCOL)
+        assert len(r["success_at"]) == 3 and r["test_scenes"] >= 10
+        assert r["signals_used"] == (2 if r["method"] == "bayes-stop" else 0)
+        assert r["user_preset"] == "human" and r["new_scene"] == "counted"
+    report = write_report(records, METHODS, INTENTIONS, tmp_path / "one",
+                          {"env": "symbolic", "budget": 2, "trials": 1}).read_text()
+    assert "*zero-signal* (baseline)" in report and "(n=1)" in report and "Wilson" in report
+    assert "**Env: symbolic**" in report
     again = run_bench(tiny(), tmp_path / "two")
-    keep = ("method", "intention", "trial", "seed", "success", "signals_used", "final_preference", "final_goal",
-            "per_round_success")
+    keep = ("method", "intention", "trial", "seed", "success_at", "signals_used", "answers", "final_goal")
     assert [{k: r[k] for k in keep} for r in records] == [{k: r[k] for k in keep} for r in again]
 
 
 def test_resume_skips_finished_and_drops_a_torn_line(tmp_path):
     out = tmp_path / "b"
-    first = run_bench(BenchOptions(**{**tiny().model_dump(), "methods": METHODS[:1]}), out)
+    first = run_bench(BenchOptions(**{**tiny().model_dump(), "methods": METHODS[1:]}), out)
     assert len(first) == 2
     with (out / "results.jsonl").open("a") as f:
         f.write('{"method": "bayes-stop", "intent')  # a write cut off by a kill
@@ -67,11 +71,40 @@ def test_resume_skips_finished_and_drops_a_torn_line(tmp_path):
     assert len(keys) == len(set(keys)) == 4 == len(records)
 
 
+def test_resume_refuses_other_settings(tmp_path):
+    run_bench(BenchOptions(**{**tiny().model_dump(), "trials": 1, "methods": ["zero-signal"]}), tmp_path)
+    with pytest.raises(ValueError, match="other settings"):
+        run_bench(tiny(user="exact"), tmp_path)
+
+
+def test_a_plugin_signal_runs_in_bench_without_package_changes(tmp_path):
+    plugin = str(ROOT / "examples" / "my_signal.py")
+    options = BenchOptions(methods=["bayes-rating"], intentions=["stack"], trials=1, seed=1,
+                           run=RunOptions(budget=3, llm="none", env="symbolic", video="none", plugins=[plugin]))
+    (r,) = run_bench(options, tmp_path)
+    assert r.get("error") is None and r["method"] == "bayes-rating"
+    assert r["signals_used"] == 3 and set(r["answers"]) <= {"rating", "new_scene"}
+
+
+def test_bench_refuses_setups_that_cannot_run(tmp_path):
+    def bench(*args):
+        return subprocess.run([sys.executable, "-m", "activeintent.cli", "bench", *args, "--out", str(tmp_path)],
+                              capture_output=True, text=True, timeout=120)
+
+    no_model = bench("--methods", "preference", "--llm", "none")
+    assert no_model.returncode == 2 and "needs a language model" in no_model.stdout
+    nothing = bench("--intentions", "", "--suite", "")
+    assert nothing.returncode == 2 and "no intentions" in nothing.stdout
+    unknown = bench("--methods", "bayes-nope")
+    assert unknown.returncode == 2 and "valid methods" in unknown.stdout
+
+
 @pytest.mark.slow
 def test_killed_bench_resumes_without_duplicates(tmp_path):
     out = tmp_path / "killed"
     cmd = [sys.executable, "-m", "activeintent.cli", "bench", "--methods", ",".join(METHODS), "--intentions",
-           "stack,color-match,align", "--trials", "2", "--rounds", "2", "--seed", "9", "--llm", "none", "--out", str(out)]
+           "stack,color-match,align", "--trials", "2", "--budget", "2", "--seed", "9", "--llm", "none",
+           "--env", "symbolic", "--out", str(out)]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     results = out / "results.jsonl"
     deadline = time.monotonic() + 600
@@ -86,7 +119,7 @@ def test_killed_bench_resumes_without_duplicates(tmp_path):
     records = read_results(results)
     keys = [(r["method"], r["intention"], r["trial"]) for r in records]
     assert len(keys) == len(set(keys)) == 12
-    assert (out / "report.md").exists() and (out / "success_vs_rounds.png").stat().st_size > 0
+    assert (out / "report.md").exists() and (out / "success_vs_signals.png").stat().st_size > 0
 
 
 @pytest.mark.slow
@@ -94,9 +127,8 @@ def test_parallel_jobs_give_the_same_results(tmp_path):
     serial = run_bench(tiny(), tmp_path / "serial")
     parallel = run_bench(tiny(jobs=2), tmp_path / "parallel")
     key = lambda r: (r["method"], r["intention"], r["trial"])  # noqa: E731
-    pick = lambda r: (key(r), r["success"], r["final_goal"], r["signals_used"])  # noqa: E731
+    pick = lambda r: (key(r), r["success_at"], r["final_goal"], r["signals_used"])  # noqa: E731
     assert sorted(map(pick, serial)) == sorted(map(pick, parallel))
-    assert Path(tmp_path / "parallel" / "episodes").is_dir()
 
 
 CRASHING_INTENTION = '''
@@ -108,11 +140,11 @@ _stack = get_intention("stack")
 
 
 class Crash(type(_stack)):
-    """Behaves as `stack`, but its worker process dies (as on a native crash) when sampling."""
+    """Behaves as `stack`, but its worker process dies (as on a native crash) when judged."""
 
     name = "crash"
 
-    def sample_scene(self, rng):
+    def feasible(self, scene):
         os._exit(3)
 '''
 
@@ -121,18 +153,10 @@ class Crash(type(_stack)):
 def test_a_dying_worker_is_recorded_and_the_bench_goes_on(tmp_path):
     path = tmp_path / "crash.py"
     path.write_text(CRASHING_INTENTION)
-    options = BenchOptions(methods=["bayes-stop"], intentions=["stack"], intention_files=[f"{path}:Crash"],
-                           trials=1, seed=5, jobs=2, run=RunOptions(rounds=1, save_videos=False, llm="none"))
+    options = BenchOptions(methods=["zero-signal"], intentions=["stack"], intention_files=[f"{path}:Crash"],
+                           trials=1, seed=5, jobs=2, run=RunOptions(budget=1, llm="none", env="symbolic", video="none"))
     records = run_bench(options, tmp_path / "out")
     by = {r["intention"]: r for r in records}
     assert len(records) == 2
     assert "worker process died" in by[f"{path}:Crash"]["error"]
     assert not by["stack"].get("error")
-
-
-def test_resume_refuses_other_settings(tmp_path):
-    run_bench(BenchOptions(**{**tiny().model_dump(), "trials": 0}), tmp_path)  # writes bench.json only
-    other = tiny()
-    other.run.rounds = 3
-    with pytest.raises(ValueError, match="other settings"):
-        run_bench(other, tmp_path)

@@ -8,7 +8,7 @@ import pytest
 
 from activeintent.sim.env import SimConfig, TabletopEnv
 from activeintent.sim.render import render_frame, render_state
-from activeintent.sim.trajectory import Trajectory
+from activeintent.world.trajectory import Trajectory
 from activeintent.sim.video import export_video, frame_times
 from activeintent.world import (
     BLOCK_SIZE,

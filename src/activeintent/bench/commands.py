@@ -61,7 +61,8 @@ def bench(
     from activeintent.bench.report import plot_success_vs_signals, write_report
     from activeintent.bench.runner import BenchOptions, protocol_fields, run_bench
     from activeintent.runner import check_options
-    from activeintent.suites import resolve, suite
+    from activeintent.suites import resolve
+    from activeintent.suites import suite as suite_names
 
     console = Console()
     try:
@@ -71,7 +72,7 @@ def bench(
         method_list = _split(methods) or ["bayes-preference", "bayes-stop", "zero-signal", "random-query"]
         for m in method_list:
             check_options(run.model_copy(update={"method": m}))
-        intention_list = _split(intentions) or [i for s in _split(suite) for i in suite(s)]
+        intention_list = _split(intentions) or [i for s in _split(suite) for i in suite_names(s)]
         for name in intention_list:
             resolve(name)
         for f in intention_file or []:

@@ -89,6 +89,11 @@ class PreferenceSignal(Signal):
         a, b = shown[0].outcome, shown[1].outcome
         return choice_probabilities(judge.utility(a), judge.utility(b), similarity(a, b), model)
 
+    def learner_model(self) -> PreferenceModel:
+        # People choose noisily (Boltzmann β of a few units on a [0, 1] utility scale): a learner
+        # assuming near-perfect choosers over-trusts single answers.
+        return PreferenceModel(beta=5.0, lapse=0.05)
+
     def predictive(self, shown, judge, model) -> np.ndarray:
         return self._probs(shown, judge, model)
 

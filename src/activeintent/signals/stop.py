@@ -92,7 +92,9 @@ class StopSignal(Signal):
     page = "clicker.html"
 
     def learner_model(self) -> StopModel:
-        return StopModel()
+        # People react after the bad move shows, never before, with right-skewed delays: a
+        # log-normal (mean 0.9 s, sd 0.6 s) keeps a late press from being read as a later step.
+        return StopModel(delay="lognormal", delay_mean=0.9, delay_sd=0.6)
 
     def _one(self, shown: list[Trajectory]) -> Trajectory:
         if len(shown) != 1:

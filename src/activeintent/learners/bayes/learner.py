@@ -50,6 +50,7 @@ class BayesConfig(BaseModel):
     top_k: int = Field(16, ge=1, description="plans come from this many most probable hypotheses")
     explore: int = Field(6, ge=0, description="... plus this many random other hypotheses")
     max_plans: int = Field(36, ge=2, description="candidate plans per scene")
+    final_top_k: int = Field(10, ge=1, description="the final answer picks among the plans of this many likely z")
     done_threshold: float = Field(0.95, gt=0, le=1, description="says 'done' when top z holds this much belief")
     new_scene_error: float = Field(0.1, gt=0, lt=0.5, description="assumed P(a person's new-scene answer is wrong)")
     surprise: float = Field(0.1, gt=0, lt=1, description="P(h) / max_z P(h|z) below this: ask the model for new z")
@@ -212,8 +213,8 @@ class BayesLearner(Learner):
         w = self.weights * feasible
         w = w / w.sum() if w.sum() > 0 else self.weights
         outs = [predict(state, [])] + candidate_plans(
-            self.hyps, w, state, self.rng, top_k=2 * self.config.top_k, explore=0,
-            prefixes=False, limit=3 * self.config.max_plans)
+            self.hyps, w, state, self.rng, top_k=self.config.final_top_k, explore=0,
+            prefixes=False, limit=self.config.max_plans)
         finals = [facts(o.traj.outcome) for o in outs]
         for h in self.hyps:
             h.prefetch(finals)
