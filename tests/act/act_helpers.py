@@ -2,10 +2,33 @@
 
 from __future__ import annotations
 
+import os
+import re
 import socket
+
+import pytest
+
+from activeintent.act.isolation import isolation_status
+from activeintent.act.sandbox import SandboxLimits
 
 SECRET_NAME = "ACTIVEINTENT_FAKE_API_KEY"
 SECRET_VALUE = "sk-fake-7f3a9c1e2b4d6f8a0c2e4a6b8d0f"
+TEST_LIMITS = SandboxLimits(cpu_seconds=1, wall_seconds=3.0, memory_mb=128)
+
+_UNCLEAN = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u200b-\u200f\u2028-\u202e\u2060-\u2069\ufeff\ud800-\udfff]")
+_ADDRESS = re.compile(r"0x[0-9a-fA-F]{8,}")
+
+
+def require_namespaces() -> None:
+    """Skip a test that needs bubblewrap namespaces where there are none — but fail in CI
+    (environment CI set), where a missing bubblewrap is a broken set-up, not a reason to skip."""
+    status = isolation_status()
+    if status.available:
+        return
+    message = f"sandbox namespaces unavailable: {status.detail}"
+    if os.environ.get("CI"):
+        pytest.fail(message + " (CI is set: bubblewrap must be installed and working)")
+    pytest.skip(message)
 
 
 def assert_no_connection(srv: socket.socket) -> None:
@@ -16,3 +39,27 @@ def assert_no_connection(srv: socket.socket) -> None:
         return
     conn.close()
     raise AssertionError(f"the sandbox reached the test server from {addr}")
+
+
+def assert_no_datagram(srv: socket.socket) -> None:
+    try:
+        data, addr = srv.recvfrom(4096)
+    except BlockingIOError:
+        return
+    raise AssertionError(f"the sandbox sent a datagram {data[:40]!r} from {addr}")
+
+
+def assert_clean_text(text: str | None, limit: int = 4000) -> None:
+    """Valid UTF-8, no control or formatting characters but newline and tab, no addresses."""
+    if text is None:
+        return
+    text.encode("utf-8")  # raises on lone surrogates
+    assert not _UNCLEAN.search(text), repr(text[:200])
+    assert not _ADDRESS.search(text), repr(text[:200])
+    assert len(text) <= limit
+
+
+def process_state(pid: int) -> str:
+    """The one-letter state of a process ('T' stopped, 't' traced, 'Z' zombie...)."""
+    with open(f"/proc/{pid}/stat") as f:
+        return f.read().rsplit(")", 1)[1].split()[0]

@@ -7,6 +7,7 @@ import signal
 
 import numpy as np
 import pytest
+from act_helpers import require_namespaces
 
 from activeintent.act.cap import CapExecutor, extract_program
 from activeintent.act.robot_api import RobotAPI
@@ -157,14 +158,16 @@ def test_program_without_robot_calls_fails(sandbox, state):
 
 
 def test_wall_time_limit_kills(state):
-    with Sandbox(SandboxLimits(cpu_seconds=30, wall_seconds=1.0)) as sb:
+    require_namespaces()
+    with Sandbox(SandboxLimits(cpu_seconds=30, wall_seconds=1.0), isolation="bwrap") as sb:
         result = sb.run("while True:\n    pass", state)
         assert result.error_kind == "wall" and "wall-time" in result.error
         assert sb.run("put_first_on_second('red block', 'blue bowl')", state).ok
 
 
 def test_dead_worker_is_replaced(state):
-    with Sandbox() as sb:
+    require_namespaces()
+    with Sandbox(isolation="bwrap") as sb:
         os.killpg(sb.worker_pid, signal.SIGKILL)
         result = sb.run("put_first_on_second('red block', 'blue bowl')", state)
         assert result.ok and len(result.skills) == 1

@@ -1,186 +1,149 @@
-"""Hostile programs: each is refused by the allow-list or contained by the process limits —
-no file created, no network, no secret read, the parent unharmed, a clear 'program' failure."""
+"""The hostile corpus (hostile_corpus.py): each program refused by the allow-list or contained
+— with the guard, without it (the OS layer alone), and for the programs that go for the OS,
+with only the namespaces and with only seccomp. Nothing may leak out in any of these runs."""
 
 from __future__ import annotations
 
 import os
+import stat
+from collections import Counter
 from pathlib import Path
 
 import pytest
-from act_helpers import SECRET_NAME, SECRET_VALUE, assert_no_connection
+from act_helpers import (
+    SECRET_NAME,
+    SECRET_VALUE,
+    assert_clean_text,
+    assert_no_connection,
+    assert_no_datagram,
+    process_state,
+)
+from hostile_corpus import CONTAINED, CORPUS, HARMLESS, REFUSED
 
 from activeintent.act.cap import CapExecutor
+from activeintent.act.sandbox import SandboxResult
 from activeintent.llm.scripted import ScriptedModel
 
-REFUSED, CONTAINED = "refused", "contained"
 CONTAINED_KINDS = {"cpu", "wall", "memory", "runtime", "output", "crash"}
-
-# (id, program, expectation). CANARY is a path that must never exist; PORT a test server.
-HOSTILE: list[tuple[str, str, str]] = [
-    # imports in all spellings
-    ("import", "import os\nos.system('touch CANARY')", REFUSED),
-    ("import-as", "import os.path as p\nsay(p.exists('/'))", REFUSED),
-    ("from-import", "from os import system\nsystem('touch CANARY')", REFUSED),
-    ("relative-import", "from . import sandbox", REFUSED),
-    ("dunder-import", "__import__('os').system('touch CANARY')", REFUSED),
-    ("builtins-subscript", "__builtins__['__import__']('os')", REFUSED),
-    ("builtins-attr", "__builtins__.__import__('os')", REFUSED),
-    ("importlib", "importlib.import_module('os').system('touch CANARY')", REFUSED),
-    ("builtins-module", "builtins.__import__('os')", REFUSED),
-    ("lambda-import", "(lambda: __import__('subprocess'))().run(['touch', 'CANARY'])", REFUSED),
-    ("exec", "exec('import os')", REFUSED),
-    ("eval", "eval(\"__import__('os')\")", REFUSED),
-    ("compile", "compile('import os', 'x', 'exec')", REFUSED),
-    ("globals", "say(globals()['__builtins__'])", REFUSED),
-    ("locals", "say(locals())", REFUSED),
-    ("vars", "say(vars(say))", REFUSED),
-    ("getattr", "say(getattr(say, '__glo' + 'bals__'))", REFUSED),
-    # dunder and attribute-chain escapes
-    ("subclasses", "().__class__.__bases__[0].__subclasses__()", REFUSED),
-    ("mro", "''.__class__.__mro__[1].__subclasses__()", REFUSED),
-    ("mro-method", "str.mro()", REFUSED),
-    ("func-globals", "say(say.__globals__['RobotAPI'])", REFUSED),
-    ("bound-self", "say(get_obj_pos.__self__.state)", REFUSED),
-    (
-        "catch-warnings",
-        "[c for c in ().__class__.__base__.__subclasses__() if c.__name__ == 'catch_warnings'][0]()"
-        "._module.__builtins__['__import__']('os')",
-        REFUSED,
-    ),
-    ("type", "say(type(say))", REFUSED),
-    ("object", "say(object.__subclasses__())", REFUSED),
-    ("numpy-dict", "say(np.__dict__)", REFUSED),
-    ("numpy-ctypeslib", "np.ctypeslib.load_library('libc', '/lib')", REFUSED),
-    ("numpy-load", "say(np.load('/etc/passwd'))", REFUSED),
-    ("numpy-tofile", "np.array([1.0]).tofile('CANARY')", REFUSED),
-    ("numpy-lib", "np.lib.npyio.savetxt('CANARY', [1])", REFUSED),
-    ("numpy-ctypes", "say(np.zeros(3).ctypes.data)", REFUSED),
-    ("walrus-dunder", "(f := __import__)", REFUSED),
-    ("kwarg-dunder", "dict(__builtins__=1)", REFUSED),
-    ("param-dunder", "def f(__x):\n    return __x\nf(1)", REFUSED),
-    ("except-dunder", "try:\n    1 / 0\nexcept Exception as __e:\n    pass", REFUSED),
-    # format-string attribute access
-    ("str-format", "say('{0.__class__.__bases__}'.format(1))", REFUSED),
-    ("str-format-globals", "say('{0.__globals__}'.format(say))", REFUSED),
-    ("str-format-unbound", "say(str.format('{0.__class__}', 1))", REFUSED),
-    ("format-map", "say('{a.__class__}'.format_map({'a': 1}))", REFUSED),
-    ("fstring-dunder", "say(f'{say.__globals__}')", REFUSED),
-    # generator / frame / traceback tricks
-    ("gi-frame", "g = (x for x in [1])\nsay(g.gi_frame.f_back.f_globals)", REFUSED),
-    ("yield", "def f():\n    yield 1\ng = f()\nsay(g.gi_code)", REFUSED),
-    ("tb-frame", "try:\n    1 / 0\nexcept Exception as e:\n    say(e.__traceback__.tb_frame.f_globals)", REFUSED),
-    ("with-traceback", "try:\n    1 / 0\nexcept Exception as e:\n    say(e.with_traceback(None))", REFUSED),
-    ("class", "class A:\n    pass", REFUSED),
-    ("async", "async def f():\n    pass", REFUSED),
-    ("global", "def f():\n    global x\n    x = 1\nf()", REFUSED),
-    ("nonlocal", "def f():\n    x = 1\n    def g():\n        nonlocal x\n    g()\nf()", REFUSED),
-    # environment, files, sockets
-    ("environ", "import os\nsay(os.environ['SECRET_NAME'])", REFUSED),
-    ("proc-environ", "say(open('/proc/self/environ').read())", REFUSED),
-    ("read-passwd", "say(open('/etc/passwd').read())", REFUSED),
-    ("write-file", "open('CANARY', 'w').write('pwned')", REFUSED),
-    ("with-open", "with open('CANARY', 'w') as f:\n    f.write('x')", REFUSED),
-    ("socket", "import socket\nsocket.create_connection(('127.0.0.1', PORT))", REFUSED),
-    ("socket-dunder", "__import__('socket').socket().connect(('127.0.0.1', PORT))", REFUSED),
-    # interpreter tricks
-    ("breakpoint", "breakpoint()", REFUSED),
-    ("input", "say(input())", REFUSED),
-    ("help", "help()", REFUSED),
-    ("memoryview", "memoryview(b'abc')", REFUSED),
-    ("super", "super()", REFUSED),
-    ("exit", "exit()", REFUSED),
-    ("fork-bomb", "import os\nwhile True:\n    os.fork()", REFUSED),
-    ("signal", "import signal\nsignal.signal(signal.SIGXCPU, signal.SIG_IGN)\nwhile True:\n    pass", REFUSED),
-    ("sleep", "import time\ntime.sleep(10 ** 6)", REFUSED),
-    ("nested-parens", "x = " + "(" * 5000 + "1" + ")" * 5000, REFUSED),
-    ("deep-unary", "x = " + "-" * 200000 + "1", REFUSED),
-    ("huge-program", "x = 1\n" * 20000, REFUSED),
-    ("null-byte", "say('a')\x00", REFUSED),
-    # resource exhaustion: contained by the limits
-    ("infinite-loop", "while True:\n    pass", CONTAINED),
-    ("busy-sum", "say(sum(range(10 ** 12)))", CONTAINED),
-    ("list-bomb", "x = [0] * 10 ** 10", CONTAINED),
-    ("string-bomb", "s = 'a' * 10 ** 11", CONTAINED),
-    ("doubling", "l = [1]\nwhile True:\n    l = l + l", CONTAINED),
-    ("numpy-bomb", "a = np.zeros((10 ** 6, 10 ** 6))", CONTAINED),
-    ("recursion", "def f(n):\n    return f(n + 1)\nf(0)", CONTAINED),
-    ("huge-say", "say('x' * 10 ** 9)", CONTAINED),
-    ("say-flood", "for i in range(10 ** 6):\n    say('x' * 1000)", CONTAINED),
-    ("unknown-object", "put_first_on_second('red block', 'purple bowl')", CONTAINED),
-    ("bad-target", "put_first_on_second('red block', {'a': 1})", CONTAINED),
-    ("name-error", "say(RobotAPI)", CONTAINED),
-    ("too-many-moves", "while True:\n    put_first_on_second('red block', 'blue bowl')", CONTAINED),
-]
+ALL_KINDS = CONTAINED_KINDS | {"refused", "sandbox", None}
+IDS = [h.name for h in CORPUS]
+OS_PROGRAMS = [h for h in CORPUS if "os" in h.tags]
+VICTIM_TEXT = "precious"
 
 
-def test_corpus_is_large_enough():
-    assert len(HOSTILE) >= 40
-    assert len({name for name, _, _ in HOSTILE}) == len(HOSTILE)
+def test_corpus_size_and_outcomes():
+    assert len(CORPUS) >= 80
+    assert len(set(IDS)) == len(IDS)
+    counts = Counter(h.guarded for h in CORPUS)
+    assert set(counts) <= {REFUSED, CONTAINED, HARMLESS}
+    assert counts[REFUSED] and counts[CONTAINED] and counts[HARMLESS]
+    assert len(OS_PROGRAMS) >= 30
 
 
-@pytest.mark.parametrize(("name", "program", "expect"), HOSTILE, ids=[h[0] for h in HOSTILE])
-def test_hostile_program(name, program, expect, sandbox, listener, state, tmp_path):
-    canary = tmp_path / "canary"
-    program = (
-        program.replace("CANARY", str(canary))
-        .replace("PORT", str(listener.getsockname()[1]))
-        .replace("SECRET_NAME", SECRET_NAME)
-    )
-    env_before, pid_before = dict(os.environ), os.getpid()
-    executor = CapExecutor(ScriptedModel([program]), sandbox=sandbox)
-    result = executor.to_plan("do something tricky for the hostile test", state)
+def _env() -> dict[str, str]:
+    return {k: v for k, v in os.environ.items() if k != "PYTEST_CURRENT_TEST"}
 
-    assert result.failure is not None and result.failure.stage == "program", result
-    kind = result.failure.details["kind"]
-    if expect == REFUSED:
-        assert kind == "refused", result.failure.message
-    else:
-        assert kind in CONTAINED_KINDS, result.failure.message
-    assert result.failure.message.strip()
-    assert SECRET_VALUE not in result.model_dump_json()
-    assert not canary.exists() and list(tmp_path.iterdir()) == []
-    assert_no_connection(listener)
-    assert os.getpid() == pid_before and dict(os.environ) == env_before
-    # The sandbox still works after every hostile program.
+
+class Scene:
+    """The test's side of one run: the paths, processes and listeners a program goes for."""
+
+    def __init__(self, tmp_path: Path, listener, udp_listener, victim) -> None:
+        self.tmp = tmp_path
+        self.canary = tmp_path / "canary"
+        self.open_dir = tmp_path / "open"
+        self.open_dir.mkdir()
+        self.open_dir.chmod(0o777)
+        self.victim_file = tmp_path / "victim.txt"
+        self.victim_file.write_text(VICTIM_TEXT)
+        self.victim_file.chmod(0o666)
+        self.victim_stat = self.victim_file.stat()
+        self.listener, self.udp_listener, self.victim = listener, udp_listener, victim
+        self.env_before, self.pid_before = _env(), os.getpid()
+
+    def fill(self, program: str) -> str:
+        for key, value in (
+            ("OPEN_DIR", self.open_dir), ("VICTIM_FILE", self.victim_file), ("VICTIM_PID", self.victim.pid),
+            ("PARENT_PID", os.getpid()), ("UDP_PORT", self.udp_listener.getsockname()[1]),
+            ("PORT", self.listener.getsockname()[1]), ("SECRET_NAME", SECRET_NAME), ("CANARY", self.canary),
+        ):
+            program = program.replace(key, str(value))
+        return program
+
+    def assert_untouched(self, result: SandboxResult) -> None:
+        dump = result.model_dump_json()
+        assert SECRET_VALUE not in dump, "the parent's secret came back"
+        assert "root:x:0:0" not in dump, "/etc/passwd came back"
+        assert not self.canary.exists(), "a file was written outside the jail"
+        assert sorted(p.name for p in self.tmp.iterdir()) == ["open", "victim.txt"]
+        assert list(self.open_dir.iterdir()) == [], "something was created in a world-writable folder"
+        now = self.victim_file.stat()
+        assert self.victim_file.read_text() == VICTIM_TEXT
+        assert stat.S_IMODE(now.st_mode) == 0o666 and now.st_mtime_ns == self.victim_stat.st_mtime_ns
+        assert_no_connection(self.listener)
+        assert_no_datagram(self.udp_listener)
+        assert os.getpid() == self.pid_before and _env() == self.env_before
+        assert self.victim.poll() is None, "the victim process was killed"
+        assert process_state(self.victim.pid) not in ("T", "t"), "the victim process was stopped or traced"
+        # Whatever comes back is clean, bounded text.
+        assert result.error_kind in ALL_KINDS
+        assert len(result.said) <= 100 and sum(len(s) for s in result.said) <= 4000
+        for text in result.said:
+            assert_clean_text(text)
+        assert_clean_text(result.error, limit=600)
+        for failure in result.skill_failures:
+            assert_clean_text(failure)
+
+
+@pytest.fixture
+def scene(tmp_path, listener, udp_listener, victim) -> Scene:
+    return Scene(tmp_path, listener, udp_listener, victim)
+
+
+def _still_works(sandbox, state) -> None:
     after = sandbox.run("put_first_on_second('red block', 'blue bowl')", state)
-    assert after.ok and len(after.skills) == 1
+    assert after.ok and len(after.skills) == 1, after
 
 
-# Without the allow-list (all builtins, imports allowed), the OS layer still contains them.
-UNGUARDED: list[tuple[str, str]] = [
-    ("env-secret", "import os\nsay(os.environ.get('SECRET_NAME', 'none'))\nsay(len(os.environ))"),
-    ("read-passwd", "say(open('/etc/passwd').read())"),
-    ("parent-environ", "import os\nsay(open(f'/proc/{os.getppid()}/environ').read())"),
-    ("write-file", "open('CANARY', 'w').write('pwned')"),
-    ("socket", "import socket\ns = socket.create_connection(('127.0.0.1', PORT))"),
-    ("fork", "import os\nos.fork()"),
-    ("subprocess", "import subprocess\nsubprocess.run(['touch', 'CANARY'])"),
-    # ctypes is loaded already (numpy uses it) and needs no file; system() cannot fork.
-    ("ctypes", "import ctypes\nstatus = ctypes.CDLL(None).system(b'touch CANARY')\nassert status == 0, status"),
-]
+@pytest.mark.parametrize("hostile", CORPUS, ids=IDS)
+def test_guarded(hostile, sandbox, state, scene):
+    """With the guard, as `--executor cap` runs programs: each has its expected outcome, and
+    every failure reaches the learner as a 'program' ExecutionFailure."""
+    executor = CapExecutor(ScriptedModel([scene.fill(hostile.program)]), sandbox=sandbox)
+    plan = executor.to_plan("do something tricky for the hostile test", state)
+    result = sandbox.run(scene.fill(hostile.program), state) if hostile.guarded == HARMLESS else None
+    if hostile.guarded != HARMLESS:
+        assert plan.failure is not None and plan.failure.stage == "program", plan
+        assert plan.failure.message.strip()
+        kind = plan.failure.details["kind"]
+        if hostile.guarded == REFUSED:
+            assert kind == "refused", plan.failure.message
+        else:
+            assert kind in CONTAINED_KINDS, plan.failure.message
+        result = SandboxResult(said=plan.said, error=plan.failure.message, error_kind=kind)
+    assert SECRET_VALUE not in plan.model_dump_json()
+    scene.assert_untouched(result)
+    _still_works(sandbox, state)
 
 
-@pytest.mark.parametrize(("name", "program"), UNGUARDED, ids=[u[0] for u in UNGUARDED])
-def test_os_layer_contains_unguarded_programs(name, program, unguarded_sandbox, listener, state, tmp_path):
-    canary = tmp_path / "canary"
-    program = (
-        program.replace("CANARY", str(canary))
-        .replace("PORT", str(listener.getsockname()[1]))
-        .replace("SECRET_NAME", SECRET_NAME)
-    )
-    result = unguarded_sandbox.run(program, state)
-    dump = result.model_dump_json()
-    assert SECRET_VALUE not in dump and "root:" not in dump
-    assert not canary.exists()
-    assert_no_connection(listener)
-    if name == "env-secret":  # the worker's environment is empty except thread settings
-        assert result.ok and result.said[0] == "none" and int(result.said[1]) <= 4
-    else:
-        assert not result.ok, result
+@pytest.mark.parametrize("hostile", CORPUS, ids=IDS)
+def test_unguarded(hostile, unguarded_sandbox, state, scene):
+    """Without the guard (all builtins, imports allowed): the OS layer contains every program."""
+    result = unguarded_sandbox.run(scene.fill(hostile.program), state)
+    scene.assert_untouched(result)
+    _still_works(unguarded_sandbox, state)
 
 
-@pytest.mark.skipif(os.geteuid() != 0, reason="the empty chroot is only set up when running as root")
-def test_os_layer_hides_the_filesystem(unguarded_sandbox, state, tmp_path):
-    target = tmp_path / "made-by-sandbox"
-    result = unguarded_sandbox.run(f"import os\nos.mkdir({str(target)!r})\nsay(os.listdir('/'))", state)
-    assert not result.ok and not Path(target).exists()
+@pytest.mark.parametrize("hostile", OS_PROGRAMS, ids=[h.name for h in OS_PROGRAMS])
+def test_namespaces_alone(hostile, namespaces_only_sandbox, state, scene):
+    """No guard, no seccomp: the namespaces (and limits) alone contain what goes for the OS."""
+    result = namespaces_only_sandbox.run(scene.fill(hostile.program), state)
+    scene.assert_untouched(result)
+    _still_works(namespaces_only_sandbox, state)
+
+
+@pytest.mark.parametrize("hostile", OS_PROGRAMS, ids=[h.name for h in OS_PROGRAMS])
+def test_seccomp_alone(hostile, seccomp_only_sandbox, state, scene):
+    """No guard, no namespaces (--unsafe-no-isolation): seccomp and limits alone contain it."""
+    result = seccomp_only_sandbox.run(scene.fill(hostile.program), state)
+    scene.assert_untouched(result)
+    _still_works(seccomp_only_sandbox, state)

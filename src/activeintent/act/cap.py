@@ -1,6 +1,10 @@
 """``--executor cap``: Code as Policies. The model writes a Python program against the
 tabletop robot API (see :mod:`activeintent.act.robot_api`); the program runs in the sandbox and
 the robot calls it made become the plan for y.
+
+Building the executor checks that programs can run isolated (bubblewrap namespaces) and raises
+:class:`~activeintent.act.isolation.SandboxUnavailable` (a ``ValueError``, with the reason)
+when they cannot and the user did not pass ``--unsafe-no-isolation``.
 """
 
 from __future__ import annotations
@@ -8,6 +12,7 @@ from __future__ import annotations
 import re
 
 from activeintent.act.base import ExecutionFailure, Executor, PlanResult, render_prompt
+from activeintent.act.isolation import require_isolation
 from activeintent.act.sandbox import Sandbox, default_sandbox
 from activeintent.llm.base import ChatModel, Message, ModelError
 from activeintent.world.state import WorldState
@@ -29,6 +34,8 @@ class CapExecutor(Executor):
 
     def __init__(self, model: ChatModel | None = None, *, sandbox: Sandbox | None = None, max_tokens: int = 512) -> None:
         super().__init__(model)
+        if sandbox is None and model is not None:
+            require_isolation()  # refuse now, with the reason, rather than at every program
         self.sandbox = sandbox
         self.max_tokens = max_tokens
 

@@ -4,8 +4,13 @@ A program may only use plain Python control flow, functions, comprehensions and 
 robot API provides. Everything that can reach the interpreter's internals is refused before the
 program runs: imports, every name or attribute starting with ``_``, introspection builtins,
 frame/generator/code attributes (which need no underscore), ``str.format`` (whose format
-strings can walk attributes), classes, ``global``/``nonlocal``, ``yield``, ``async`` and ``with``.
-The process limits of the sandbox are the second layer for what this cannot see.
+strings can walk attributes), classes, ``global``/``nonlocal``, ``yield``, ``async`` (also
+asynchronous comprehensions) and ``with``; numpy's raw-memory and file attributes, and ``dtype``
+arguments other than plain numeric literals (no object or structured arrays).
+
+A check of source text cannot close every hole: it is only the first layer. What contains a
+program is the worker's isolation (namespaces, seccomp, resource limits: see ``sandbox`` and
+``docs/security.md``), which holds even with this guard switched off.
 """
 
 from __future__ import annotations
@@ -48,6 +53,20 @@ FORBIDDEN_ATTRIBUTES = frozenset({
     "tofile", "dump", "dumps", "ctypes", "load", "save", "savez", "savetxt", "loadtxt",
     "fromfile", "genfromtxt", "fromregex", "memmap", "lib", "ctypeslib", "testing", "f2py",
     "distutils", "compat", "source", "lookfor", "info", "show_config", "DataSource",
+    # numpy: views over raw memory, strides, buffers and in-place reinterpretation
+    "strides", "data", "base", "view", "getfield", "setfield", "setflags", "tobytes", "tostring",
+    "frombuffer", "fromstring", "stride_tricks", "as_strided", "from_dlpack", "byte_bounds",
+})
+# ``dtype=`` values and ``astype`` arguments a program may write: numeric types only.
+ALLOWED_DTYPE_NAMES = frozenset({"int", "float", "bool", "complex"})
+ALLOWED_DTYPE_ATTRIBUTES = frozenset({
+    "float16", "float32", "float64", "int8", "int16", "int32", "int64", "uint8", "uint16", "uint32",
+    "uint64", "bool_", "complex64", "complex128",
+})
+ALLOWED_DTYPE_STRINGS = frozenset({
+    "int", "float", "bool", "complex", "int8", "int16", "int32", "int64", "uint8", "uint16",
+    "uint32", "uint64", "float16", "float32", "float64", "complex64", "complex128", "i1", "i2",
+    "i4", "i8", "u1", "u2", "u4", "u8", "f2", "f4", "f8", "c8", "c16", "b1", "?", "i", "f", "d",
 })
 FORBIDDEN_ATTRIBUTE_PREFIXES = ("_", "gi_", "cr_", "ag_", "f_", "tb_", "co_", "func_", "im_")
 
@@ -74,6 +93,32 @@ def _check_name(name: str, node: ast.AST) -> None:
 def _check_attribute(attr: str, node: ast.AST) -> None:
     if attr in FORBIDDEN_ATTRIBUTES or attr.startswith(FORBIDDEN_ATTRIBUTE_PREFIXES):
         raise GuardError(f"attribute {attr!r} is not allowed{_where(node)}")
+
+
+def _check_dtype(value: ast.expr, node: ast.AST) -> None:
+    ok = (
+        (isinstance(value, ast.Name) and value.id in ALLOWED_DTYPE_NAMES)
+        or (isinstance(value, ast.Attribute) and value.attr in ALLOWED_DTYPE_ATTRIBUTES)
+        or (isinstance(value, ast.Constant) and isinstance(value.value, str)
+            and value.value.lstrip("<>=|") in ALLOWED_DTYPE_STRINGS)
+        or (isinstance(value, ast.Constant) and value.value is None)
+    )
+    if not ok:
+        raise GuardError(
+            f"only numeric dtypes written literally (float, int, bool, np.float64, 'f8', ...) are "
+            f"allowed{_where(node)}"
+        )
+
+
+def _check_call(node: ast.Call) -> None:
+    for kw in node.keywords:
+        if kw.arg == "dtype":
+            _check_dtype(kw.value, node)
+    if isinstance(node.func, ast.Attribute) and node.func.attr == "astype":
+        if not node.args and not any(kw.arg == "dtype" for kw in node.keywords):
+            raise GuardError(f"astype needs a dtype{_where(node)}")
+        for arg in node.args[:1]:
+            _check_dtype(arg, node)
 
 
 def check_program(source: str) -> ast.Module:
@@ -104,6 +149,10 @@ def check_program(source: str) -> ast.Module:
             for a in [*args.posonlyargs, *args.args, *args.kwonlyargs, args.vararg, args.kwarg]:
                 if a is not None:
                     _check_name(a.arg, node)
+        elif isinstance(node, ast.comprehension) and node.is_async:
+            raise GuardError(f"asynchronous comprehensions are not allowed{_where(node.target)}")
+        elif isinstance(node, ast.Call):
+            _check_call(node)
         elif isinstance(node, ast.keyword) and node.arg is not None:
             _check_name(node.arg, node)
         elif isinstance(node, ast.ExceptHandler) and node.name:

@@ -10,6 +10,7 @@ earlier moves. The recorded skills leave the sandbox as data.
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from types import SimpleNamespace
@@ -25,6 +26,7 @@ from activeintent.world.state import WorldState
 
 MAX_SKILLS = 50
 MAX_SAID_CHARS = 4_000
+MAX_SAID_MESSAGES = 100
 
 CORNERS = ("top left corner", "top right corner", "bottom left corner", "bottom right corner")
 SIDES = ("top side", "right side", "bottom side", "left side")
@@ -223,6 +225,8 @@ class RobotAPI:
         text = str(msg)
         if self._said_chars + len(text) > MAX_SAID_CHARS:
             raise RuntimeError(f"too much output: say() may print at most {MAX_SAID_CHARS} characters in all")
+        if len(self.said) >= MAX_SAID_MESSAGES:
+            raise RuntimeError(f"too much output: say() may be called at most {MAX_SAID_MESSAGES} times")
         self._said_chars += len(text)
         self.said.append(text)
 
@@ -243,7 +247,10 @@ class RobotAPI:
         return ns
 
 
-# Only these numpy names are visible as ``np``: math and array building, no files, no ctypes.
+# Only these numpy names are visible as ``np``: math and array building, no files, no ctypes, no
+# raw buffers. Every function is wrapped so that it cannot hand out object, void or structured
+# arrays (which, with raw memory access, reach any Python object), and ``np.ndarray`` is only a
+# type for ``isinstance``: it cannot build arrays over buffers with chosen strides.
 _NUMPY_NAMES = (
     "array", "asarray", "zeros", "ones", "full", "zeros_like", "ones_like", "arange", "linspace",
     "eye", "mean", "median", "sum", "prod", "min", "max", "amin", "amax", "argmin", "argmax",
@@ -254,12 +261,53 @@ _NUMPY_NAMES = (
     "isclose", "allclose", "where", "unique", "cumsum", "diff", "std", "var", "isnan", "isfinite",
     "mod", "sign", "maximum", "minimum", "percentile", "all", "any", "transpose", "reshape",
     "squeeze", "expand_dims", "tile", "repeat", "flip", "roll", "interp", "exp", "log", "power",
-    "square", "nonzero", "count_nonzero", "meshgrid", "array_equal", "ndarray", "newaxis",
+    "square", "nonzero", "count_nonzero", "meshgrid", "array_equal", "newaxis",
     "ptp", "average", "fabs", "floor_divide", "lexsort",
 )
+_SAFE_KINDS = frozenset("biufcUS")  # bool, integers, floats, complex, text; not object/void/time
+
+
+def _check_arrays(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind not in _SAFE_KINDS or value.dtype.fields is not None:
+            raise TypeError(f"arrays of dtype {value.dtype.str!r} are not available in robot programs")
+    elif isinstance(value, (tuple, list)):
+        for item in value:
+            _check_arrays(item)
+    return value
+
+
+def _safe_numpy_function(fn: Any) -> Any:
+    if not callable(fn) or isinstance(fn, type):
+        return fn
+
+    @functools.wraps(fn, assigned=("__name__", "__qualname__", "__doc__"))
+    def checked(*args: Any, **kwargs: Any) -> Any:
+        return _check_arrays(fn(*args, **kwargs))
+
+    return checked
+
+
+class _ArrayTypeMeta(type):
+    def __instancecheck__(cls, obj: Any) -> bool:
+        return isinstance(obj, np.ndarray)
+
+    def __call__(cls, *args: Any, **kwargs: Any) -> Any:
+        raise TypeError("np.ndarray(...) is not available in robot programs; use np.array or np.zeros")
+
+
+class ndarray(metaclass=_ArrayTypeMeta):  # noqa: N801 - stands in for np.ndarray
+    """For ``isinstance(x, np.ndarray)`` only."""
+
+
 SAFE_NUMPY = SimpleNamespace(
-    **{n: getattr(np, n) for n in _NUMPY_NAMES if hasattr(np, n)},
-    linalg=SimpleNamespace(norm=np.linalg.norm, det=np.linalg.det, inv=np.linalg.inv),
+    **{n: _safe_numpy_function(getattr(np, n)) for n in _NUMPY_NAMES if hasattr(np, n)},
+    ndarray=ndarray,
+    linalg=SimpleNamespace(
+        norm=_safe_numpy_function(np.linalg.norm),
+        det=_safe_numpy_function(np.linalg.det),
+        inv=_safe_numpy_function(np.linalg.inv),
+    ),
 )
 
 SAFE_BUILTIN_NAMES = (

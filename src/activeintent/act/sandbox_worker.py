@@ -1,14 +1,17 @@
 """The sandbox's worker process (runs in its own interpreter, never in the caller's).
 
-The parent starts it once with ``python -I`` (no environment, an empty temporary working
-directory); it imports numpy and the world model, warms them up, then loops: read a request
-(length-prefixed JSON on stdin), fork a child that runs one program under OS limits, collect
-its result (capped) within the wall-time limit, kill the child's whole process group, reply.
+The parent starts it once (see ``sandbox``): normally inside bubblewrap namespaces, always with
+``python -I``, an environment built from scratch and no inherited descriptors. It imports numpy
+and the world model, warms every code path a program may touch, then loops: read a request
+(length-prefixed JSON on stdin), fork a child that runs one program, collect its result
+(capped) within the wall-time limit, kill the child, reply.
 
 The child, before running untrusted code: starts a new session (own process group), points
-stdin/stdout/stderr at /dev/null, keeps only the result pipe (fd 3), and if it runs as root,
-chroots into an empty read-only directory and drops to ``nobody``; then it sets RLIMIT_CPU, RLIMIT_AS, RLIMIT_FSIZE = 0, RLIMIT_NOFILE = 4 (no new file or socket can
-be opened), RLIMIT_NPROC = 0 (no fork) and RLIMIT_CORE = 0.
+stdin/stdout/stderr at /dev/null, keeps only the result pipe (fd 3); if it runs as root (only
+possible without namespaces), chroots into an empty read-only directory and drops to
+``nobody``; sets RLIMIT_CPU, RLIMIT_AS, RLIMIT_FSIZE = 0, RLIMIT_NOFILE = 4, RLIMIT_NPROC = 0
+and RLIMIT_CORE = 0; and last installs the seccomp filter of ``seccomp`` (no open, socket,
+fork, exec, kill, ptrace, file-system change, mount, namespace, IPC, limit raising).
 """
 
 from __future__ import annotations
@@ -30,12 +33,15 @@ import numpy as np  # noqa: F401 - imported before forking so that children star
 
 from activeintent.act.guard import GuardError, check_program
 from activeintent.act.robot_api import RobotAPI, safe_builtins
+from activeintent.act.seccomp import Seccomp
 from activeintent.world.state import WorldState
 
 RESULT_FD = 3
-JAIL = os.path.abspath("jail")  # created empty (mode 0555) in the worker's temporary directory
+JAIL = os.path.abspath("jail")  # without namespaces, as root: empty (0555) in the worker's temp dir
 NOBODY = 65534
 MAX_MESSAGE_CHARS = 500
+MAX_REQUEST_BYTES = 64 << 20
+SECCOMP = Seccomp()  # built (and libc loaded) before any child is forked
 
 
 def read_message(stream: Any) -> dict | None:
@@ -43,6 +49,8 @@ def read_message(stream: Any) -> dict | None:
     if len(header) < 4:
         return None
     (size,) = struct.unpack(">I", header)
+    if size > MAX_REQUEST_BYTES:
+        return None
     return json.loads(stream.read(size))
 
 
@@ -100,7 +108,7 @@ def run_program(source: str, positions: dict, guard: bool) -> dict:
     }
 
 
-def _confine(limits: dict, vm_bytes: int) -> None:
+def _confine(limits: dict, vm_bytes: int, use_seccomp: bool) -> None:
     os.setsid()
     devnull = os.open(os.devnull, os.O_RDWR)
     for fd in (0, 1, 2):
@@ -121,11 +129,19 @@ def _confine(limits: dict, vm_bytes: int) -> None:
     resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
     resource.setrlimit(resource.RLIMIT_NOFILE, (RESULT_FD + 1, RESULT_FD + 1))
     resource.setrlimit(resource.RLIMIT_NPROC, (0, 0))
+    if use_seccomp and SECCOMP.available:
+        SECCOMP.install()  # last: it forbids setrlimit, chroot, open, ...
 
 
 def _child(request: dict, write_fd: int, vm_bytes: int) -> None:
     os.dup2(write_fd, RESULT_FD)
-    _confine(request["limits"], vm_bytes)
+    if not request.get("guard", True):
+        # Test mode without the allow-list: the usual attack modules are loaded before the
+        # confinement, so that the OS layer (not a failed import) is what stops them.
+        import ctypes  # noqa: F401
+        import socket  # noqa: F401
+        import subprocess  # noqa: F401
+    _confine(request["limits"], vm_bytes, bool(request.get("seccomp", True)))
     result = run_program(request["program"], request["positions"], request.get("guard", True))
     data = json.dumps(result).encode()
     cap = int(request["limits"]["max_output_bytes"])
@@ -192,10 +208,11 @@ def handle(request: dict, vm_bytes: int) -> dict:
                 timed_out = True
                 break
             time.sleep(0.0005)
-    try:
-        os.killpg(pid, signal.SIGKILL)
-    except (ProcessLookupError, PermissionError):
-        pass
+    for kill in (os.killpg, os.kill):
+        try:
+            kill(pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
     _, status = os.waitpid(pid, 0)
     elapsed = time.perf_counter() - started
     raw = b"".join(chunks)
@@ -206,7 +223,8 @@ def handle(request: dict, vm_bytes: int) -> dict:
 
 
 def main() -> None:
-    os.mkdir(JAIL, 0o555)
+    if os.getuid() == 0:  # only without namespaces: the children chroot into an empty folder
+        os.mkdir(JAIL, 0o555)
     stdin, stdout = sys.stdin.buffer, sys.stdout.buffer
     sys.stdout = sys.stderr  # nothing but protocol messages may reach the parent's pipe
     # Warm up every code path a program may touch, so children import nothing after forking.
@@ -217,7 +235,7 @@ def main() -> None:
         {"red block": (0.0, -0.5, 0.02), "blue bowl": (0.1, -0.6, 0.0), "green block": (-0.1, -0.4, 0.02)},
         True,
     )
-    write_message(stdout, {"ready": True, "pid": os.getpid()})
+    write_message(stdout, {"ready": True, "pid": os.getpid(), "uid": os.getuid(), "seccomp": SECCOMP.available})
     while (request := read_message(stdin)) is not None:
         write_message(stdout, handle(request, _vm_bytes()))
 
