@@ -81,8 +81,30 @@ def batch_program(body: str, worlds: list[dict]) -> str:
     )
 
 
+def batch_programs(body: str, worlds: list[dict], limit: int | None = None) -> list[tuple[str, list[dict]]]:
+    """``batch_program`` over consecutive groups of ``worlds``, each program within the sandbox's
+    size limit (so that many worlds make several programs, never one that is refused)."""
+    from activeintent.act.guard import MAX_PROGRAM_CHARS
+
+    limit = limit or MAX_PROGRAM_CHARS
+    base = len(batch_program(body, []))
+    groups: list[list[dict]] = []
+    size = base
+    for world in worlds:
+        extra = len(repr(world)) + 2
+        if base + extra > limit:
+            raise ValueError(f"one world alone makes a predicate program over {limit} characters")
+        if not groups or size + extra > limit:
+            groups.append([])
+            size = base
+        groups[-1].append(world)
+        size += extra
+    return [(batch_program(body, group), group) for group in groups]
+
+
 class SandboxRunner:
-    """Runs predicate batches in the act sandbox (one child process per batch)."""
+    """Runs predicate batches in the act sandbox (one child process per batch, several batches
+    when the worlds do not fit in one program)."""
 
     def __init__(self, sandbox=None):
         self._sandbox = sandbox
@@ -91,13 +113,16 @@ class SandboxRunner:
         from activeintent.act.sandbox import default_sandbox
 
         sandbox = self._sandbox or default_sandbox()
-        probe = WorldState(positions={n: (p[0], p[1], 0.02) for n, p in worlds[0]["position"].items()})
-        result = sandbox.run(batch_program(body, worlds), probe)
-        if result.error or not result.said:
-            raise ValueError(result.error or "the predicate said nothing")
-        out = result.said[-1].strip()
-        if len(out) != len(worlds) or set(out) - {"0", "1"}:
-            raise ValueError(f"malformed predicate output {out[:40]!r}")
+        out = ""
+        for program, group in batch_programs(body, worlds):
+            probe = WorldState(positions={n: (p[0], p[1], 0.02) for n, p in group[0]["position"].items()})
+            result = sandbox.run(program, probe)
+            if result.error or not result.said:
+                raise ValueError(result.error or "the predicate said nothing")
+            part = result.said[-1].strip()
+            if len(part) != len(group) or set(part) - {"0", "1"}:
+                raise ValueError(f"malformed predicate output {part[:40]!r}")
+            out += part
         return [c == "1" for c in out]
 
 

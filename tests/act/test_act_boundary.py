@@ -1,0 +1,200 @@
+"""The sandbox's boundary without a worker: result parsing that never raises, text cleaning,
+the guard's new refusals, the trimmed numpy and the seccomp program itself."""
+
+from __future__ import annotations
+
+import json
+import struct
+
+import numpy as np
+import pytest
+
+from activeintent.act import seccomp
+from activeintent.act.guard import GuardError, check_program
+from activeintent.act.robot_api import MAX_SAID_MESSAGES, SAFE_NUMPY, RobotAPI
+from activeintent.act.sandbox import Sandbox
+from activeintent.act.sanitize import clean_messages, clean_text
+
+
+# ---- result parsing -----------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "raw",
+    [
+        "[" * 100_000 + "]" * 100_000,  # RecursionError inside json
+        '{"said": ' + "[" * 50_000 + "]" * 50_000 + "}",
+        "not json",
+        "",
+        "[]",
+        "null",
+        '{"skills": "x"}',
+        '{"skills": [{"skill": "fly", "block": "red block"}]}',
+        '{"skills": [' + ",".join(['{"skill": "put_in", "block": "red block", "bowl": "blue bowl"}'] * 60) + "]}",
+        '{"skills": [{"skill": "put_in", "block": "red block", "bowl": "gold bowl"}]}',
+        '{"skills": [{"skill": "put_at", "block": "red block", "position": "\\u001b[2Jmoon"}]}',
+        '{"skills": [{"skill": "put_at", "block": "red block", "position": [NaN, 0.1]}]}',
+        '{"skills": [{"skill": "put_at", "block": "red block", "position": [1e308, 1e308]}]}',
+        '{"skill_failures": {"a": 1}}',
+        '{"error": "just a string"}',
+        '{"error": {"type": ["x"], "message": {"a": 1}, "line": "7"}}',
+        '{"said": "not a list"}',
+    ],
+)
+def test_malformed_results_never_raise(raw, state):
+    result = Sandbox._parse_result(raw, state, 0.0)
+    assert isinstance(result.error, (str, type(None)))
+    if result.error is not None:
+        assert result.error_kind in ("sandbox", "runtime")
+    assert len(result.skills) <= 50
+
+
+def test_result_strings_are_cleaned_and_capped(state):
+    raw = json.dumps({
+        "skills": [{"skill": "put_in", "block": "red block", "bowl": "blue bowl"}],
+        "skill_failures": ["\x1b[31mblocked\x1b[0m at 0x7f3a2b1c4d5e"],
+        "said": ["\ud800 lone", "\x1b]0;title\x07ok", "x" * 10_000] + ["y"] * 500,
+        "error": {"type": "ValueError\x1b[2J", "message": "\u202eevil\r" + "z" * 5000, "line": True},
+    })
+    result = Sandbox._parse_result(raw, state, 0.0)
+    assert result.said[0] == "\ufffd lone" and result.said[1] == "ok"
+    assert sum(len(s) for s in result.said) <= 4000 and len(result.said) <= 100
+    assert result.skill_failures == ["blocked at 0x…"]
+    assert result.error.startswith("ValueError: evil") and len(result.error) < 600
+    assert result.line is None and result.error_kind == "runtime"
+    json.dumps(result.model_dump()).encode("utf-8")
+
+
+def test_worker_reply_that_is_not_json_is_a_sandbox_failure(state):
+    class FakeProc:
+        def __init__(self, data: bytes) -> None:
+            import os
+
+            self.read_fd, write_fd = os.pipe()
+            os.write(write_fd, data)
+            os.close(write_fd)
+            self.stdout = open(self.read_fd, "rb")  # noqa: SIM115
+
+    sb = Sandbox(isolation="none", unsafe_no_isolation=True)
+    for payload in (b"\xff\xfe", b"[" * 5000, b"[1, 2]"):
+        sb._proc = FakeProc(struct.pack(">I", len(payload)) + payload)
+        assert sb._read(timeout=5.0) is None
+        sb._proc.stdout.close()
+    sb._proc = FakeProc(struct.pack(">I", 1 << 31))  # absurd size: refused before reading
+    assert sb._read(timeout=5.0) is None
+    sb._proc.stdout.close()
+    sb._proc = None
+
+
+# ---- text cleaning -------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    ("text", "clean"),
+    [
+        ("plain\ttext\nline two", "plain\ttext\nline two"),
+        ("\x1b[31mred\x1b[0m", "red"),
+        ("\x1b]8;;http://x\x07link\x1b]8;;\x07", "link"),
+        ("a\x1bPdevice\x1b\\b", "ab"),
+        ("over\rwrite\x08\x07\x00", "overwrite"),
+        ("\x9b31mC1", "31mC1"),
+        ("bidi\u202eevil\u2066x\u200b", "bidievilx"),
+        ("surrogate \udc80", "surrogate \ufffd"),
+        ("<object at 0x7ffd1234abcd>", "<object at 0x…>"),
+        ("small hex 0xff stays", "small hex 0xff stays"),
+    ],
+)
+def test_clean_text(text, clean):
+    assert clean_text(text) == clean
+
+
+def test_clean_text_caps_and_never_raises():
+    class Unprintable:
+        def __str__(self) -> str:
+            raise RuntimeError("no")
+
+    assert clean_text(Unprintable()) == "(unprintable)"
+    assert len(clean_text("x" * 100_000, limit=50)) == 50
+    assert clean_messages("not a list") == []
+    assert len(clean_messages(["m"] * 1000)) == 100
+
+
+# ---- guard ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "program",
+    [
+        "g = (x async for x in objects)",
+        "l = [x async for x in objects]",
+        "s = {x async for x in objects}",
+        "a = np.zeros(2).astype(object)",
+        "a = np.zeros(2).astype('O')",
+        "a = np.zeros(2).astype()",
+        "t = float\na = np.zeros(2, dtype=t)",
+        "a = np.zeros(2, dtype='V8')",
+        "a = np.zeros(2, dtype=[('f', 'O')])",
+        "say(np.zeros(2).strides)",
+        "say(np.zeros(2).view(float))",
+        "say(np.zeros(2).data)",
+    ],
+)
+def test_guard_refuses(program):
+    with pytest.raises(GuardError):
+        check_program(program)
+
+
+@pytest.mark.parametrize(
+    "program",
+    [
+        "a = np.zeros(2, dtype=float)",
+        "a = np.array([1, 2], dtype=np.int64)",
+        "a = np.round(get_obj_pos('red block') * 100).astype(int)",
+        "a = np.ones(3).astype('f8')",
+        "a = np.arange(3, dtype='<i8')",
+        "a = np.array([1.5]).astype(dtype=np.float32)",
+    ],
+)
+def test_guard_accepts_numeric_dtypes(program):
+    check_program(program)
+
+
+# ---- the numpy programs see ------------------------------------------------------------------------
+def test_safe_numpy_refuses_object_and_void_arrays():
+    for make in (lambda: SAFE_NUMPY.zeros(3, "O"), lambda: SAFE_NUMPY.array([1, "a", None]),
+                 lambda: SAFE_NUMPY.zeros(2, [("f", "f8")]), lambda: SAFE_NUMPY.asarray([object()])):
+        with pytest.raises(TypeError, match="not available"):
+            make()
+    with pytest.raises(TypeError, match="np.ndarray"):
+        SAFE_NUMPY.ndarray((2,), buffer=np.zeros(2))
+
+
+def test_safe_numpy_still_does_cap_math():
+    assert isinstance(SAFE_NUMPY.zeros(2), SAFE_NUMPY.ndarray)
+    assert not isinstance([1, 2], SAFE_NUMPY.ndarray)
+    names = SAFE_NUMPY.array(["red block", "blue bowl"])
+    assert names.dtype.kind == "U"
+    assert SAFE_NUMPY.linalg.norm(SAFE_NUMPY.array([3.0, 4.0])) == 5.0
+    assert SAFE_NUMPY.mean([[0.0, 1.0], [2.0, 3.0]], axis=0).tolist() == [1.0, 2.0]
+    assert not hasattr(SAFE_NUMPY, "frombuffer") and not hasattr(SAFE_NUMPY, "lib")
+
+
+def test_say_count_is_limited(state):
+    api = RobotAPI(state)
+    for i in range(MAX_SAID_MESSAGES):
+        api.say(i)
+    with pytest.raises(RuntimeError, match="at most"):
+        api.say("one more")
+
+
+# ---- seccomp program ---------------------------------------------------------------------------------
+@pytest.mark.parametrize("machine", ["x86_64", "aarch64"])
+def test_seccomp_program_shape(machine):
+    prog = seccomp.build_filter(machine)
+    assert prog is not None and len(prog) % 8 == 0 and len(prog) // 8 < 4096
+    denied = seccomp.denied_syscalls(machine)
+    for name in ("openat", "socket", "connect", "clone", "execve", "kill", "ptrace", "mkdirat", "unlinkat",
+                 "renameat2", "symlinkat", "fchmodat", "mount", "unshare", "setns", "bpf", "io_uring_setup"):
+        assert name in denied, name
+    assert len(set(denied.values())) == len(denied), "two names share a number"
+    # every jump stays inside the program
+    count = len(prog) // 8
+    for i in range(count):
+        code, jt, jf, _k = struct.unpack("=HBBI", prog[i * 8:(i + 1) * 8])
+        if code & 0x07 == 0x05:  # BPF_JMP
+            assert i + 1 + max(jt, jf) < count
+    assert seccomp.build_filter("sparc64") is None
