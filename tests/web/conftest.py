@@ -15,6 +15,7 @@ import pytest
 import uvicorn
 
 from activeintent.learners.registry import SIGNAL
+from activeintent.web.limits import Limits, SessionLimits
 from activeintent.web.server import create_app, runner_builder
 from activeintent.web.session import SessionManager, StudyConfig
 
@@ -31,12 +32,31 @@ CHROMIUM_ARGS = [
 ]
 
 
+class FakeClock:
+    """A clock that only moves when told to (idle timeouts and rate limits without waiting)."""
+
+    def __init__(self, start: float = 1000.0):
+        self.now = start
+
+    def __call__(self) -> float:
+        return self.now
+
+    def advance(self, seconds: float) -> None:
+        self.now += seconds
+
+
+@pytest.fixture
+def fake_clock() -> FakeClock:
+    return FakeClock()
+
+
 @dataclass
 class LiveServer:
     url: str
     out: Path
     manager: SessionManager
     config: StudyConfig
+    limits: SessionLimits
 
     def session_dir(self, sid: str) -> Path:
         return self.out / sid
@@ -50,13 +70,17 @@ def _free_port() -> int:
 
 @pytest.fixture
 def live_server(tmp_path) -> Iterator:
-    """``start(method, rounds=2, **study)`` serves a study on 127.0.0.1 for this test."""
+    """``start(method, rounds=2, limits=None, clock=None, **study)`` serves a study on
+    127.0.0.1 for this test (``limits``: a :class:`Limits` or its fields as a dict)."""
     servers: list[tuple[uvicorn.Server, threading.Thread]] = []
 
-    def start(method: str, rounds: int = 2, **study) -> LiveServer:
+    def start(method: str, rounds: int = 2, limits: Limits | dict | None = None, clock=None, **study) -> LiveServer:
         out = tmp_path / f"out-{len(servers)}"
         config = StudyConfig(method=method, signal=SIGNAL[method], rounds=rounds, out_dir=out, **study)
-        app = create_app(config, runner_builder(config, llm="none"))  # Bayesian methods, no model
+        if isinstance(limits, dict):
+            limits = Limits(**limits)
+        app = create_app(config, runner_builder(config, llm="none"),  # Bayesian methods, no model
+                         limits=limits, clock=clock or time.monotonic)
         port = _free_port()
         server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
         thread = threading.Thread(target=server.run, daemon=True)
@@ -69,7 +93,7 @@ def live_server(tmp_path) -> Iterator:
         assert server.started, "the study server did not start"
         assert httpx.get(f"{url}/api/config").status_code == 200
         servers.append((server, thread))
-        return LiveServer(url=url, out=out, manager=app.state.manager, config=config)
+        return LiveServer(url=url, out=out, manager=app.state.manager, config=config, limits=app.state.limits)
 
     yield start
     for server, thread in servers:

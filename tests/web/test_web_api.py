@@ -88,9 +88,9 @@ def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server)
     for body, status, message in bad:
         res = httpx.post(answer, json=body)
         assert res.status_code == status, (body, res.text)
-        assert message in res.json()["detail"], (body, res.json())
+        assert message in res.json()["error"]["message"], (body, res.json())
     res = httpx.post(answer, content=b"{not json", headers={"content-type": "application/json"})
-    assert res.status_code == 422 and "JSON" in res.json()["detail"]
+    assert res.status_code == 422 and "JSON" in res.json()["error"]["message"]
     assert snapshot(folder) == before, "a rejected answer changed the saved data"
 
     ok = httpx.post(answer, json={"kind": "preference", "round": 1, "choice": "B", "client_ts": 1.0})
@@ -102,16 +102,16 @@ def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server)
     after = snapshot(folder)
     replay = httpx.post(answer, json={"kind": "preference", "round": 1, "choice": "A"})
     assert replay.status_code == 409
-    assert "round 1" in replay.json()["detail"]
+    assert "round 1" in replay.json()["error"]["message"]
     waiting_state(srv.url, sid, 2)
     replay = httpx.post(answer, json={"kind": "preference", "round": 1, "choice": "A"})
-    assert replay.status_code == 409 and "waiting for round 2" in replay.json()["detail"]
+    assert replay.status_code == 409 and "waiting for round 2" in replay.json()["error"]["message"]
     assert read_rounds(folder / "rounds.jsonl") == rounds
     assert (folder / "rounds.jsonl").read_bytes() == after["rounds.jsonl"]
 
     # result only once finished
     res = httpx.get(f"{api}/sessions/{sid}/result")
-    assert res.status_code == 409 and "no result yet" in res.json()["detail"]
+    assert res.status_code == 409 and "no result yet" in res.json()["error"]["message"]
 
 
 def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server):
@@ -128,12 +128,12 @@ def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server):
     outside = [-0.5, video["duration"] + 0.5, 1e9]
     for t in outside:
         res = httpx.post(answer, json={"kind": "stop", "round": 1, "action": "stop", "time": t})
-        assert res.status_code == 422 and "outside the video" in res.json()["detail"], res.text
+        assert res.status_code == 422 and "outside the video" in res.json()["error"]["message"], res.text
     for raw in (b"NaN", b"Infinity", b"-Infinity", b'"soon"'):
         body = b'{"kind": "stop", "round": 1, "action": "stop", "time": ' + raw + b"}"
         res = httpx.post(answer, content=body, headers={"content-type": "application/json"})
         assert res.status_code == 422, (raw, res.text)
-        assert "time" in res.json()["detail"]
+        assert "time" in res.json()["error"]["message"]
     for body, message in [
         ({"kind": "stop", "round": 1, "action": "stop"}, "needs 'time'"),
         ({"kind": "stop", "round": 1, "action": "looks_good", "time": 1.0}, "takes no 'time'"),
@@ -141,7 +141,7 @@ def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server):
         ({"kind": "preference", "round": 1, "choice": "A"}, "asks for stop answers"),
     ]:
         res = httpx.post(answer, json=body)
-        assert res.status_code == 422 and message in res.json()["detail"], (body, res.text)
+        assert res.status_code == 422 and message in res.json()["error"]["message"], (body, res.text)
     assert snapshot(folder) == before
 
     t = 0.45  # media time → trajectory time 0.45 s: frame 4, tick round(0.45 / dt)
@@ -162,18 +162,20 @@ def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server):
     # a finished session takes no answers; its saved data stays as it is
     done = snapshot(folder)
     res = httpx.post(answer, json={"kind": "stop", "round": 2, "action": "looks_good"})
-    assert res.status_code == 409 and "finished" in res.json()["detail"]
+    assert res.status_code == 409 and "finished" in res.json()["error"]["message"]
     assert snapshot(folder) == done
 
 
 def test_unknown_sessions_path_traversal_and_isolation(live_server):
-    srv = live_server("bayes-preference", rounds=2, seed=1, max_sessions=2, video_size=(128, 128))
+    srv = live_server("bayes-preference", rounds=2, seed=1, max_sessions=2, video_size=(128, 128),
+                      limits={"max_sessions_per_client": 3})
     api = f"{srv.url}/api"
     a = httpx.post(f"{api}/sessions").json()["id"]
     b = httpx.post(f"{api}/sessions").json()["id"]
     assert a != b
     full = httpx.post(f"{api}/sessions")
-    assert full.status_code == 503 and "limit 2" in full.json()["detail"]
+    assert full.status_code == 503 and "limit 2" in full.json()["error"]["message"]
+    assert full.json()["error"]["code"] == "server_full" and int(full.headers["retry-after"]) > 0
     waiting_state(srv.url, a, 1)
     waiting_state(srv.url, b, 1)
     before_b = snapshot(srv.session_dir(b))
@@ -195,7 +197,7 @@ def test_unknown_sessions_path_traversal_and_isolation(live_server):
         ]:
             res = httpx.request(method, api + path, json=body)
             assert res.status_code == 404, (method, path, res.text)
-            assert "unknown session" in res.json()["detail"]
+            assert "unknown session" in res.json()["error"]["message"]
 
     # only this session's videos are served: no other files, no other folders
     ok, _ = raw_get(srv.url, f"/api/sessions/{a}/files/round1_a.webm")
@@ -259,7 +261,7 @@ def test_stopping_the_server_cancels_sessions_in_progress(live_server):
     session = srv.manager.get(sid)
     assert not session.active and session.status == "cancelled" and "server stopped" in session.error
     res = httpx.post(f"{srv.url}/api/sessions/{sid}/answer", json={"kind": "stop", "round": 1, "action": "looks_good"})
-    assert res.status_code == 409 and "cancelled" in res.json()["detail"]
+    assert res.status_code == 409 and "cancelled" in res.json()["error"]["message"]
     log = [json.loads(x) for x in (srv.session_dir(sid) / "events.jsonl").read_text().splitlines()]
     assert log[-1]["type"] == "session_cancelled"
     assert read_rounds(srv.session_dir(sid) / "rounds.jsonl") == []

@@ -32,6 +32,11 @@ def serve(
     retriever: opt.Retriever = "symbolic",
     answer_timeout: Annotated[float, typer.Option("--answer-timeout", min=1.0, help="Seconds to wait for one answer before a session is abandoned")] = 1800.0,
     max_sessions: Annotated[int, typer.Option("--max-sessions", min=1, help="Sessions in progress at once")] = 4,
+    max_sessions_per_client: Annotated[int, typer.Option("--max-sessions-per-client", min=1, help="Sessions in progress at once from one client address")] = 2,
+    max_new_sessions_per_hour: Annotated[int, typer.Option("--max-new-sessions-per-hour", min=1, help="Sessions one client address may start per hour")] = 30,
+    idle_timeout: Annotated[float, typer.Option("--idle-timeout", min=0.1, help="Minutes without a request from a session's page before it is cancelled and its slot freed")] = 3.0,
+    max_request_kb: Annotated[int, typer.Option("--max-request-kb", min=1, help="Largest request body in KiB")] = 128,
+    events_quota_mb: Annotated[float, typer.Option("--events-quota-mb", min=0.01, help="Largest events.jsonl the browser may fill per session, in MiB")] = 5.0,
 ) -> None:
     """Serve the study: participants give the preference or stop signal in the browser.
 
@@ -43,6 +48,7 @@ def serve(
     from activeintent.intentions.registry import IntentionError, resolve_intention
     from activeintent.learners.registry import SIGNAL, check_method
     from activeintent.runner import RunOptions
+    from activeintent.web.limits import Limits
     from activeintent.web.server import create_app, runner_builder
     from activeintent.web.session import StudyConfig
 
@@ -58,7 +64,10 @@ def serve(
     config = StudyConfig(method=method, signal=SIGNAL[method], rounds=rounds, intention=intention,
                          show_estimate=show_estimate, out_dir=out, seed=seed,
                          answer_timeout=answer_timeout, max_sessions=max_sessions)
-    app = create_app(config, runner_builder(config, **extra))
+    limits = Limits(max_sessions_per_client=max_sessions_per_client,
+                    max_new_sessions_per_hour=max_new_sessions_per_hour, idle_timeout=idle_timeout * 60,
+                    max_body_bytes=max_request_kb * 1024, events_quota_bytes=int(events_quota_mb * 2**20))
+    app = create_app(config, runner_builder(config, **extra), limits=limits)
     console = Console()
     shown = "localhost" if host in ("127.0.0.1", "::1") else host
     console.print(f"[bold]activeintent study[/]: {method} ({SIGNAL[method]} signal), {rounds} rounds; "

@@ -8,66 +8,101 @@ thank-you). Each page polls ``GET /api/sessions/{id}`` and answers with
 
 from __future__ import annotations
 
+import asyncio
 import json
+import logging
+import time
+from collections.abc import Callable
 from contextlib import asynccontextmanager
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from fastapi import FastAPI, HTTPException, Request
-from fastapi.exceptions import RequestValidationError
-from fastapi.responses import FileResponse, JSONResponse
+from fastapi import FastAPI, Request
+from fastapi.concurrency import run_in_threadpool
+from fastapi.responses import FileResponse
 from fastapi.staticfiles import StaticFiles
-from pydantic import BaseModel, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from activeintent.signals import PreferenceFeedback, StopFeedback
 from activeintent.users.human import AnswerRejected, Question, stop_feedback
-from activeintent.web.session import EpisodeBuilder, SessionManager, StudyConfig, WebSession
+from activeintent.web.errors import ApiError, install_error_handlers
+from activeintent.web.limits import BodyGuard, Limits, SessionLimits, event_lines_size
+from activeintent.web.session import (
+    SERVED_FILE,
+    EpisodeBuilder,
+    SessionManager,
+    StudyConfig,
+    WebSession,
+)
 
 STATIC = Path(__file__).parent / "static"
+MAX_FILE_NAME = 64  # longer than any video name the server writes
+log = logging.getLogger("activeintent.web")
 PAGES = {"/": "index.html", "/preference": "preference.html", "/clicker": "clicker.html", "/done": "done.html"}
 
 
 # -- request bodies ---------------------------------------------------------------------------
-class NewSession(BaseModel):
+# Every body forbids fields it does not know and bounds every number: a typo or a probe is a
+# 422, never something silently ignored or stored.
+MAX_ROUND = 10_000
+
+
+def _client_ts():
+    return Field(None, ge=0, le=1e11, allow_inf_nan=False, description="browser clock (s since the epoch)")
+
+
+class _Body(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class NewSession(_Body):
     participant: str | None = Field(None, max_length=100, description="optional participant code")
     seed: int | None = Field(None, ge=0, le=2**31 - 1, description="seed of the episode (default: next)")
 
+    @field_validator("participant")
+    @classmethod
+    def _printable(cls, v: str | None) -> str | None:
+        if v is not None and not v.isprintable():
+            raise ValueError("the participant code takes printable characters only")
+        return v
 
-class PreferenceAnswer(BaseModel):
+
+class PreferenceAnswer(_Body):
     kind: Literal["preference"]
-    round: int = Field(ge=1, description="the round this answers (as given in the session state)")
+    round: int = Field(ge=1, le=MAX_ROUND, description="the round this answers (as given in the session state)")
     choice: Literal["A", "B", "cant_choose", "new_scene"]
-    client_ts: float | None = Field(None, allow_inf_nan=False, description="browser clock (s)")
+    client_ts: float | None = _client_ts()
 
 
-class StopAnswer(BaseModel):
+class StopAnswer(_Body):
     kind: Literal["stop"]
-    round: int = Field(ge=1, description="the round this answers (as given in the session state)")
+    round: int = Field(ge=1, le=MAX_ROUND, description="the round this answers (as given in the session state)")
     action: Literal["stop", "looks_good", "new_scene"]
     time: float | None = Field(
         None, allow_inf_nan=False, description="for action 'stop': the video's currentTime in seconds"
     )
-    client_ts: float | None = Field(None, allow_inf_nan=False, description="browser clock (s)")
+    client_ts: float | None = _client_ts()
 
 
 Answer = Annotated[PreferenceAnswer | StopAnswer, Field(discriminator="kind")]
 
 
-class ClientEvent(BaseModel):
-    type: str = Field(min_length=1, max_length=64)
-    client_ts: float = Field(allow_inf_nan=False, description="the browser's clock, seconds since the epoch")
-    round: int | None = None
+class ClientEvent(_Body):
+    type: str = Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.:-]+$")
+    client_ts: float = Field(ge=0, le=1e11, allow_inf_nan=False,
+                             description="the browser's clock, seconds since the epoch")
+    round: int | None = Field(None, ge=0, le=MAX_ROUND)
     data: dict[str, Any] = Field(default_factory=dict)
 
     @field_validator("data")
     @classmethod
     def _small(cls, v: dict) -> dict:
-        if len(json.dumps(v)) > 4000:
+        if len(json.dumps(v, allow_nan=False)) > 4000:
             raise ValueError("event data is limited to 4000 characters of JSON")
         return v
 
 
-class EventBatch(BaseModel):
+class EventBatch(_Body):
     events: list[ClientEvent] = Field(min_length=1, max_length=200)
 
 
@@ -96,15 +131,28 @@ def _feedback_maker(session: WebSession, body: PreferenceAnswer | StopAnswer):
     return make
 
 
-def create_app(config: StudyConfig, builder: EpisodeBuilder | None = None) -> FastAPI:
+def create_app(
+    config: StudyConfig,
+    builder: EpisodeBuilder | None = None,
+    limits: Limits | None = None,
+    clock: Callable[[], float] = time.monotonic,
+) -> FastAPI:
     """The app for one study. ``builder`` builds each session's episode; by default
-    :func:`activeintent.runner.build_episode` with the study's options."""
+    :func:`activeintent.runner.build_episode` with the study's options. ``limits`` are the
+    per-client, size and quota limits (see :mod:`activeintent.web.limits`); ``clock`` is what
+    the idle timeout and rate limits count seconds with."""
+    limits = limits or Limits()
     manager = SessionManager(config, builder or runner_builder(config))
+    guard = SessionLimits(manager, limits, clock=clock)
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
-        yield
-        manager.shutdown()
+        sweeper = asyncio.create_task(_sweep(guard))
+        try:
+            yield
+        finally:
+            sweeper.cancel()
+            manager.shutdown()
 
     app = FastAPI(
         title="activeintent human-in-the-loop study",
@@ -115,26 +163,15 @@ def create_app(config: StudyConfig, builder: EpisodeBuilder | None = None) -> Fa
         lifespan=lifespan,
     )
     app.state.manager = manager
-
-    @app.exception_handler(AnswerRejected)
-    async def _rejected(request: Request, exc: AnswerRejected):
-        return JSONResponse({"detail": str(exc)}, status_code=exc.status)
-
-    @app.exception_handler(RequestValidationError)
-    async def _invalid(request: Request, exc: RequestValidationError):
-        problems = []
-        for err in exc.errors():
-            where = ".".join(str(p) for p in err.get("loc", ()) if p != "body")
-            problems.append(f"{where}: {err.get('msg')}" if where else str(err.get("msg")))
-        # the offending input is not echoed back: it may not even be valid JSON (NaN)
-        errors = [{"loc": [str(p) for p in e.get("loc", ())], "msg": str(e.get("msg")), "type": str(e.get("type"))}
-                  for e in exc.errors()]
-        return JSONResponse({"detail": "invalid request: " + "; ".join(problems), "errors": errors}, status_code=422)
+    app.state.limits = guard
+    install_error_handlers(app)
+    app.add_middleware(BodyGuard, max_body_bytes=limits.max_body_bytes)
 
     def session_or_404(sid: str) -> WebSession:
         session = manager.get(sid)
         if session is None:
-            raise HTTPException(404, f"unknown session {sid!r}")
+            raise ApiError(404, "unknown_session", f"unknown session {sid[:40]!r}")
+        guard.touch(sid)  # somebody still cares about it: not idle
         return session
 
     @app.get("/api/config", summary="The study's configuration (what every session runs)")
@@ -149,9 +186,10 @@ def create_app(config: StudyConfig, builder: EpisodeBuilder | None = None) -> Fa
         }
 
     @app.post("/api/sessions", status_code=201, summary="Start a session (its episode starts at once)")
-    def create_session(body: NewSession | None = None) -> dict:
+    def create_session(request: Request, body: NewSession | None = None) -> dict:
         body = body or NewSession()
-        session = manager.create(participant=body.participant, seed=body.seed)
+        client = request.client.host if request.client else "unknown"
+        session = guard.create(client, participant=body.participant, seed=body.seed)
         return session.state()
 
     @app.get("/api/sessions/{sid}", summary="Session state: round i of K, the question, z, status")
@@ -168,22 +206,30 @@ def create_app(config: StudyConfig, builder: EpisodeBuilder | None = None) -> Fa
     @app.post("/api/sessions/{sid}/events", summary="Append raw UI events (client timestamps kept)")
     def post_events(sid: str, body: EventBatch) -> dict:
         session = session_or_404(sid)
-        n = session.log_events([e.model_dump() for e in body.events])
+        events = [e.model_dump() for e in body.events]
+        with guard.events_quota(session, event_lines_size(events)):
+            n = session.log_events(events)
         return {"logged": n}
 
     @app.get("/api/sessions/{sid}/result", summary="The episode's result (summary.json) once finished")
     def get_result(sid: str) -> dict:
         session = session_or_404(sid)
         if session.result is None:
-            raise HTTPException(409, f"session {sid} is {session.status}; no result yet")
+            raise ApiError(409, "no_result_yet", f"session {sid} is {session.status}; no result yet")
         return session.result
 
     @app.get("/api/sessions/{sid}/files/{name}", summary="A video of this session", response_class=FileResponse)
     def get_file(sid: str, name: str):
         session = session_or_404(sid)
-        path = session.file(name)
+        path = None
+        if len(name) <= MAX_FILE_NAME and SERVED_FILE.fullmatch(name):
+            try:
+                path = session.file(name)
+            except OSError:  # whatever the file system thinks of the name: not one of ours
+                path = None
         if path is None:
-            raise HTTPException(404, f"no file {name!r} in session {sid} (only its .webm/.gif videos are served)")
+            raise ApiError(404, "file_not_found", f"no file {name[:80]!r} in session {sid} "
+                           "(only its .webm/.gif videos are served)")
         media = "video/webm" if path.suffix == ".webm" else "image/gif"
         return FileResponse(path, media_type=media, headers={"Cache-Control": "no-store"})
 
@@ -191,6 +237,19 @@ def create_app(config: StudyConfig, builder: EpisodeBuilder | None = None) -> Fa
         app.add_api_route(route, _page(page), methods=["GET"], include_in_schema=False)
     app.mount("/static", StaticFiles(directory=STATIC), name="static")
     return app
+
+
+async def _sweep(guard: SessionLimits) -> None:
+    """Cancel idle sessions now and then, so an abandoned tab frees its slot without waiting
+    for the next new session to ask."""
+    every = max(1.0, min(30.0, guard.limits.idle_timeout / 4))
+    while True:
+        await asyncio.sleep(every)
+        try:
+            await run_in_threadpool(guard.expire_idle)
+            guard.forget_quiet_clients()
+        except Exception:  # the sweeper must outlive any one bad sweep
+            log.exception("idle sweep failed")
 
 
 def _page(name: str):

@@ -18,9 +18,11 @@ const Study = (() => {
     let data = null;
     try { data = await res.json(); } catch (_) { data = null; }
     if (!res.ok) {
-      const msg = data && data.detail ? data.detail : `HTTP ${res.status}`;
-      const err = new Error(typeof msg === "string" ? msg : JSON.stringify(msg));
+      // every error body is {"error": {"status", "code", "message"}}
+      const info = data && data.error ? data.error : {};
+      const err = new Error(typeof info.message === "string" ? info.message : `HTTP ${res.status}`);
       err.status = res.status;
+      err.code = info.code;
       throw err;
     }
     return data;

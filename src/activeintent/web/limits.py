@@ -1,0 +1,313 @@
+"""What keeps one client from spoiling a study for the others.
+
+* :class:`BodyGuard` (ASGI middleware): refuses a body larger than ``max_body_bytes`` before
+  reading it (by its Content-Length) or as soon as a streamed body passes the limit (413), and
+  lets only strict JSON into the API: UTF-8, finite numbers, integers within ±2**53, no lone
+  surrogates, no duplicate keys, nesting at most 32 deep (422; 415 for a non-JSON type).
+* :class:`SessionLimits`: admission of new sessions (at most ``max_sessions_per_client`` in
+  progress per client address, ``max_new_sessions_per_hour`` started per client address per
+  hour, the study's ``max_sessions`` in all), the idle timeout that cancels a session nobody
+  has asked about for ``idle_timeout`` seconds (so an abandoned tab frees its slot), and the
+  quota on what clients may write into a session's ``events.jsonl``.
+
+Time comes from an injectable clock so that expiry can be tested without waiting.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import threading
+import time
+from collections import deque
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, Field
+from starlette.datastructures import Headers
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from activeintent.web.errors import ApiError, error_response
+from activeintent.web.session import SessionManager, WebSession
+
+MAX_JSON_DEPTH = 32
+MAX_JSON_INT = 2**53  # what a browser's Number holds exactly
+# bytes an events.jsonl line adds around the event itself ("server_ts", "source")
+EVENT_LINE_OVERHEAD = 64
+
+
+class Limits(BaseModel):
+    """The server's limits (the study's ``max_sessions`` is the global session limit)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    max_sessions_per_client: int = Field(2, ge=1, description="sessions in progress per client address")
+    max_new_sessions_per_hour: int = Field(30, ge=1, description="sessions one client address may start per hour")
+    idle_timeout: float = Field(
+        180.0, gt=0, description="seconds without a request about a session before it is cancelled"
+    )
+    max_body_bytes: int = Field(128 * 1024, ge=1024, description="largest request body")
+    events_quota_bytes: int = Field(
+        5 * 1024 * 1024, ge=1024, description="largest events.jsonl clients may fill in one session"
+    )
+    settle_seconds: float = Field(
+        2.0, ge=0, description="how long a new session waits for idle sessions it cancelled to end"
+    )
+
+
+# -- strict JSON --------------------------------------------------------------------------------
+class _Rejected:
+    """Stands in for a value JSON must not carry, so the walk can say where it was."""
+
+    def __init__(self, why: str):
+        self.why = why
+
+
+class StrictJSONError(ValueError):
+    def __init__(self, code: str, message: str):
+        super().__init__(message)
+        self.code, self.message = code, message
+
+
+def _float(text: str) -> float | _Rejected:
+    value = float(text)
+    return value if math.isfinite(value) else _Rejected(f"{text[:20]} is not a finite number")
+
+
+def _int(text: str) -> int | _Rejected:
+    digits = text.lstrip("-")
+    if len(digits) > 16 or abs(int(text)) > MAX_JSON_INT:
+        return _Rejected(f"{text[:20]}{'…' if len(text) > 20 else ''} is out of range (at most ±2**53)")
+    return int(text)
+
+
+def _constant(name: str) -> _Rejected:
+    return _Rejected(f"{name} is not a finite number (JSON allows only finite numbers)")
+
+
+def _object(pairs: list[tuple[str, Any]]) -> dict:
+    obj: dict = {}
+    for key, value in pairs:
+        if key in obj:
+            raise StrictJSONError("invalid_json", f"the key {key[:40]!r} appears twice in one object")
+        obj[key] = value
+    return obj
+
+
+def _utf8(text: str) -> bool:
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
+def parse_strict_json(raw: bytes) -> Any:
+    """The value of a JSON body, or :class:`StrictJSONError` saying what is wrong and where."""
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise StrictJSONError("invalid_json", "the body is not UTF-8 text") from None
+    try:
+        value = json.loads(text, parse_float=_float, parse_int=_int, parse_constant=_constant,
+                           object_pairs_hook=_object)
+    except json.JSONDecodeError as err:
+        raise StrictJSONError("invalid_json", f"the body is not valid JSON: {err.msg} at character {err.pos}") from None
+    except RecursionError:
+        raise StrictJSONError("invalid_json", f"the body nests deeper than {MAX_JSON_DEPTH} levels") from None
+    # walk without recursion: (value, path, depth)
+    stack: list[tuple[Any, str, int]] = [(value, "", 0)]
+    while stack:
+        item, path, depth = stack.pop()
+        where = f"{path}: " if path else ""
+        if isinstance(item, _Rejected):
+            raise StrictJSONError("non_finite_number" if "finite" in item.why else "number_out_of_range",
+                                  where + item.why)
+        if isinstance(item, str) and not _utf8(item):
+            raise StrictJSONError("invalid_json", where + "a string holds an unpaired surrogate (\\ud800-\\udfff)")
+        if isinstance(item, dict | list):
+            if depth >= MAX_JSON_DEPTH:
+                raise StrictJSONError("invalid_json", f"the body nests deeper than {MAX_JSON_DEPTH} levels")
+            entries = item.items() if isinstance(item, dict) else enumerate(item)
+            for key, sub in entries:
+                if isinstance(key, str) and not _utf8(key):
+                    raise StrictJSONError("invalid_json", where + "a key holds an unpaired surrogate")
+                stack.append((sub, f"{path}.{key}" if path else str(key), depth + 1))
+    return value
+
+
+def _json_type(content_type: str | None) -> bool:
+    if not content_type:
+        return True  # FastAPI reads a body without a type as JSON
+    main = content_type.split(";", 1)[0].strip().lower()
+    return main == "application/json" or (main.startswith("application/") and main.endswith("+json"))
+
+
+class BodyGuard:
+    """ASGI middleware: the body size limit for every request and strict JSON for the API's."""
+
+    def __init__(self, app: ASGIApp, max_body_bytes: int, json_prefix: str = "/api/"):
+        self.app, self.max_body_bytes, self.json_prefix = app, max_body_bytes, json_prefix
+
+    async def _refuse(self, scope: Scope, receive: Receive, send: Send, status: int, code: str, message: str,
+                      close: bool = False) -> None:
+        headers = {"Connection": "close"} if close else None
+        await error_response(status, code, message, headers=headers)(scope, receive, send)
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        headers = Headers(scope=scope)
+        limit = self.max_body_bytes
+        too_large = f"the request body is larger than {limit} bytes"
+        declared = headers.get("content-length")
+        if declared is not None and declared.strip().isdigit() and int(declared) > limit:
+            # refused from the header alone: not one byte of the body is read
+            await self._refuse(scope, receive, send, 413, "body_too_large", too_large, close=True)
+            return
+        chunks: list[bytes] = []
+        size = 0
+        while True:
+            message = await receive()
+            if message["type"] != "http.request":  # the client went away
+                return
+            chunk = message.get("body", b"")
+            size += len(chunk)
+            if size > limit:
+                await self._refuse(scope, receive, send, 413, "body_too_large", too_large, close=True)
+                return
+            chunks.append(chunk)
+            if not message.get("more_body", False):
+                break
+        body = b"".join(chunks)
+        if body and scope["path"].startswith(self.json_prefix) and scope["method"] in ("POST", "PUT", "PATCH"):
+            if not _json_type(headers.get("content-type")):
+                await self._refuse(scope, receive, send, 415, "unsupported_media_type",
+                                   "the API takes JSON bodies (Content-Type: application/json)")
+                return
+            try:
+                parse_strict_json(body)
+            except StrictJSONError as err:
+                await self._refuse(scope, receive, send, 422, err.code, err.message)
+                return
+
+        replayed = False
+
+        async def replay() -> Message:
+            nonlocal replayed
+            if not replayed:
+                replayed = True
+                return {"type": "http.request", "body": body, "more_body": False}
+            return await receive()
+
+        await self.app(scope, replay, send)
+
+
+# -- sessions -----------------------------------------------------------------------------------
+class SessionLimits:
+    """Admission, idle expiry and the events quota of one server's sessions."""
+
+    def __init__(self, manager: SessionManager, limits: Limits, clock: Callable[[], float] = time.monotonic):
+        self.manager, self.limits, self.clock = manager, limits, clock
+        self.max_sessions = manager.config.max_sessions
+        self._lock = threading.Lock()
+        self._quota_lock = threading.Lock()
+        self._owner: dict[str, str] = {}  # session id -> client address
+        self._seen: dict[str, float] = {}  # session id -> clock time of the last request about it
+        self._expired: set[str] = set()
+        self._started: dict[str, deque[float]] = {}  # client -> clock times of its recent sessions
+
+    # -- admission ----------------------------------------------------------------------------
+    def create(self, client: str, participant: str | None = None, seed: int | None = None) -> WebSession:
+        cancelled = self.expire_idle()
+        deadline = time.monotonic() + self.limits.settle_seconds
+        for s in cancelled:  # their slots are free once their episodes have stopped
+            s.join(max(0.0, deadline - time.monotonic()))
+        with self._lock:
+            now = self.clock()
+            started = self._started.setdefault(client, deque())
+            while started and now - started[0] >= 3600:
+                started.popleft()
+            live = [s for s in self.manager.all() if s.active]
+            mine = [s for s in live if self._owner.get(s.id) == client]
+            retry = str(max(1, math.ceil(min(self.limits.idle_timeout, 60))))
+            if len(mine) >= self.limits.max_sessions_per_client:
+                raise ApiError(
+                    429, "too_many_sessions",
+                    f"this address has {len(mine)} sessions in progress (limit "
+                    f"{self.limits.max_sessions_per_client} per client); finish or close one first",
+                    headers={"Retry-After": retry},
+                )
+            if len(started) >= self.limits.max_new_sessions_per_hour:
+                wait = math.ceil(3600 - (now - started[0]))
+                raise ApiError(
+                    429, "session_rate_limited",
+                    f"this address started {len(started)} sessions in the last hour (limit "
+                    f"{self.limits.max_new_sessions_per_hour}); try again in {wait} s",
+                    headers={"Retry-After": str(max(1, wait))},
+                )
+            if len(live) >= self.max_sessions:
+                raise ApiError(
+                    503, "server_full",
+                    f"{len(live)} sessions are in progress (limit {self.max_sessions}); try again later",
+                    headers={"Retry-After": retry},
+                )
+            session = self.manager.create(participant=participant, seed=seed)
+            self._owner[session.id] = client
+            self._seen[session.id] = now
+            started.append(now)
+            return session
+
+    def forget_quiet_clients(self) -> None:
+        """Drop the start times older than an hour (bounded memory for many addresses)."""
+        with self._lock:
+            now = self.clock()
+            for client in list(self._started):
+                times = self._started[client]
+                while times and now - times[0] >= 3600:
+                    times.popleft()
+                if not times:
+                    del self._started[client]
+
+    # -- idle expiry --------------------------------------------------------------------------
+    def touch(self, sid: str) -> None:
+        with self._lock:
+            self._seen[sid] = self.clock()
+
+    def expire_idle(self) -> list[WebSession]:
+        """Cancel the sessions in progress that nobody asked about for ``idle_timeout`` s."""
+        cancelled = []
+        with self._lock:
+            now = self.clock()
+            for s in self.manager.all():
+                if not s.active or s.id in self._expired:
+                    continue
+                seen = self._seen.setdefault(s.id, now)
+                if now - seen > self.limits.idle_timeout:
+                    self._expired.add(s.id)
+                    cancelled.append(s)
+        for s in cancelled:
+            s.cancel(f"no request about this session for {self.limits.idle_timeout:g} s (idle timeout)")
+        return cancelled
+
+    # -- events quota -------------------------------------------------------------------------
+    @contextmanager
+    def events_quota(self, session: WebSession, size: int) -> Iterator[None]:
+        """Hold while writing ``size`` bytes of client events: refused (413) past the quota."""
+        with self._quota_lock:
+            path = session.dir / "events.jsonl"
+            used = path.stat().st_size if path.exists() else 0
+            quota = self.limits.events_quota_bytes
+            if used + size > quota:
+                raise ApiError(
+                    413, "session_quota_exceeded",
+                    f"this session's event log is full ({used} of {quota} bytes); no more events are kept",
+                )
+            yield
+
+
+def event_lines_size(events: list[dict]) -> int:
+    """Bytes ``events`` add to events.jsonl (an upper bound); ValueError for a non-finite number."""
+    return sum(len(json.dumps(e, allow_nan=False)) + EVENT_LINE_OVERHEAD for e in events)
