@@ -1,0 +1,119 @@
+"""Session limits on a live server: per client address, in all, per hour, and the idle timeout
+that frees an abandoned session's slot. Time is a fake clock moved by the test, never a sleep."""
+
+from __future__ import annotations
+
+import json
+import time
+
+import httpx
+import pytest
+import uvicorn
+from typer.testing import CliRunner
+
+from activeintent.cli import app as cli
+
+pytestmark = pytest.mark.slow  # real episodes
+
+
+def client(address: str) -> httpx.Client:
+    """A client whose requests come from ``address`` (any 127.x.y.z is loopback on Linux)."""
+    return httpx.Client(transport=httpx.HTTPTransport(local_address=address), timeout=60)
+
+
+def waiting(c: httpx.Client, url: str, sid: str, timeout: float = 180) -> dict:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        s = c.get(f"{url}/api/sessions/{sid}").json()
+        assert s["status"] not in ("failed", "cancelled"), s["error"]
+        if s["status"] == "waiting-for-answer":
+            return s
+        time.sleep(0.05)
+    raise AssertionError(f"session {sid} never asked")
+
+
+def error(res: httpx.Response) -> dict:
+    err = res.json()["error"]
+    assert err["status"] == res.status_code
+    return err
+
+
+def test_idle_sessions_are_cancelled_and_free_their_slots(live_server, fake_clock):
+    clock = fake_clock
+    srv = live_server("bayes-stop", rounds=2, seed=1, video_size=(64, 64), max_sessions=2, clock=clock,
+                      limits={"max_sessions_per_client": 1, "idle_timeout": 60})
+    api = f"{srv.url}/api"
+    with client("127.0.0.1") as a, client("127.0.0.2") as b, client("127.0.0.3") as c:
+        sa = a.post(f"{api}/sessions").json()["id"]
+        again = a.post(f"{api}/sessions")
+        assert again.status_code == 429 and error(again)["code"] == "too_many_sessions"
+        sb = b.post(f"{api}/sessions").json()["id"]
+        waiting(a, srv.url, sa)
+        waiting(b, srv.url, sb)
+        full = c.post(f"{api}/sessions")
+        assert full.status_code == 503 and error(full)["code"] == "server_full"
+
+        clock.advance(45)
+        assert b.get(f"{api}/sessions/{sb}").status_code == 200  # b's page still polls
+        clock.advance(30)  # a: 75 s without a request; b: 30 s
+        new = c.post(f"{api}/sessions")
+        assert new.status_code == 201, new.text  # a's slot was freed for it
+
+        state_a = b.get(f"{api}/sessions/{sa}").json()
+        assert state_a["status"] == "cancelled" and "idle timeout" in state_a["error"]
+        assert b.get(f"{api}/sessions/{sb}").json()["status"] == "waiting-for-answer"
+        late = a.post(f"{api}/sessions/{sa}/answer", json={"kind": "stop", "round": 1, "action": "looks_good"})
+        assert late.status_code == 409 and "cancelled" in error(late)["message"]
+        log = [json.loads(x) for x in (srv.session_dir(sa) / "events.jsonl").read_text().splitlines()]
+        assert log[-1]["type"] == "session_cancelled" and "idle" in log[-1]["reason"]
+        # a may start again once a slot is free: b and c hold both now
+        assert a.post(f"{api}/sessions").status_code == 503
+
+
+def test_a_polled_session_is_not_idle(live_server, fake_clock):
+    clock = fake_clock
+    srv = live_server("bayes-stop", rounds=1, seed=2, video_size=(64, 64), clock=clock,
+                      limits={"idle_timeout": 60})
+    sid = httpx.post(f"{srv.url}/api/sessions").json()["id"]
+    for _ in range(5):  # five minutes of a page that polls every 50 s
+        clock.advance(50)
+        assert httpx.get(f"{srv.url}/api/sessions/{sid}").status_code == 200
+        assert srv.limits.expire_idle() == []
+    clock.advance(61)
+    assert [s.id for s in srv.limits.expire_idle()] == [sid]
+    assert srv.limits.expire_idle() == []  # cancelled once
+    assert srv.manager.get(sid).join(120)
+
+
+def test_a_client_may_start_only_so_many_sessions_per_hour(live_server, fake_clock):
+    clock = fake_clock
+    srv = live_server("bayes-stop", rounds=1, seed=3, video_size=(64, 64), max_sessions=4, clock=clock,
+                      limits={"max_new_sessions_per_hour": 2, "max_sessions_per_client": 4, "idle_timeout": 7200})
+    api = f"{srv.url}/api"
+    assert [httpx.post(f"{api}/sessions").status_code for _ in range(2)] == [201, 201]
+    clock.advance(1800)
+    third = httpx.post(f"{api}/sessions")
+    assert third.status_code == 429 and error(third)["code"] == "session_rate_limited"
+    assert 1700 <= int(third.headers["retry-after"]) <= 1800
+    clock.advance(1801)
+    assert httpx.post(f"{api}/sessions").status_code == 201
+
+
+def test_serve_options_set_the_limits(tmp_path, monkeypatch):
+    served = {}
+    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: served.update(app=app, **kw))
+    res = CliRunner().invoke(cli, [
+        "serve", "--method", "bayes-stop", "--llm", "none", "--out", str(tmp_path / "study"),
+        "--max-sessions", "3", "--max-sessions-per-client", "1", "--max-new-sessions-per-hour", "7",
+        "--idle-timeout", "2.5", "--max-request-kb", "8", "--events-quota-mb", "0.5",
+    ])
+    assert res.exit_code == 0, res.output
+    limits = served["app"].state.limits
+    assert limits.max_sessions == 3 and served["app"].state.manager.config.max_sessions == 3
+    assert limits.limits.max_sessions_per_client == 1 and limits.limits.max_new_sessions_per_hour == 7
+    assert limits.limits.idle_timeout == 150.0
+    assert limits.limits.max_body_bytes == 8 * 1024 and limits.limits.events_quota_bytes == 512 * 1024
+    for bad in (["--max-sessions-per-client", "0"], ["--idle-timeout", "0"], ["--max-request-kb", "0"]):
+        res = CliRunner().invoke(cli, ["serve", "--method", "bayes-stop", "--out", str(tmp_path / "x"), *bad])
+        assert res.exit_code != 0, bad
+    assert not (tmp_path / "x").exists()
