@@ -90,6 +90,7 @@ def run(
     cache: opt.Cache = None,
     cache_mode: opt.CacheMode = D.cache_mode,
     executor: opt.Executor = D.executor,
+    unsafe_no_isolation: opt.UnsafeNoIsolation = False,
     retriever: opt.Retriever = D.retriever,
     epsilon: opt.Epsilon = D.epsilon,
     video: opt.Video = D.video,
@@ -104,6 +105,10 @@ def run(
     from activeintent.runner import DEFAULT_INTENTION, build_episode
 
     console = Console()
+    if unsafe_no_isolation:
+        from activeintent.act.isolation import allow_unsafe_no_isolation
+
+        allow_unsafe_no_isolation()
     try:
         options = opt.run_options(
             method=method, intention=intention, intention_file=intention_file, plugins=plugin, budget=budget,

@@ -29,6 +29,7 @@ BaseUrl = Annotated[str | None, typer.Option("--base-url", envvar="OPENAI_BASE_U
 Cache = Annotated[str | None, typer.Option("--cache", help="Response cache file (SQLite); default ~/.cache/activeintent")]
 CacheMode = Annotated[str, typer.Option("--cache-mode", help="record | replay | off")]
 Executor = Annotated[str, typer.Option("--executor", help="y → plan: parse | plan | cap")]
+UnsafeNoIsolation = Annotated[bool, typer.Option("--unsafe-no-isolation", envvar="ACTIVEINTENT_UNSAFE_NO_ISOLATION", help="Run model-written code (--executor cap, proposed predicates) even without the bubblewrap sandbox (docs/security.md)")]
 Retriever = Annotated[str, typer.Option("--retriever", help="r from a stop: symbolic | vision")]
 Epsilon = Annotated[float, typer.Option("--epsilon", min=0.0, help="ε: seconds before the stop for image I_b")]
 Video = Annotated[str, typer.Option("--video", help="GIFs written: none | final | all")]

@@ -114,7 +114,13 @@ def register(app: typer.Typer) -> None:
         """Executor overhead without the model call: parsing, plan validation, sandbox cost."""
         import json
 
-        report = run_bench(programs, seed)
+        from activeintent.act.isolation import SandboxUnavailable
+
+        try:
+            report = run_bench(programs, seed)
+        except SandboxUnavailable as e:  # no bubblewrap and no --unsafe-no-isolation consent
+            typer.echo(f"act-bench: {e}", err=True)
+            raise typer.Exit(2) from None
         if json_out:
             typer.echo(json.dumps(report, indent=2))
             return
