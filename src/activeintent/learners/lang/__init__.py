@@ -1,0 +1,8 @@
+"""An open-ended active learner: a goal language, one generic planner, a large belief.
+
+- expr.py — the language (node types in a registry, clauses, goals, description length);
+- planner.py — one planner for every goal, on the symbolic world model;
+- space.py — enumeration, behavioural de-duplication on probe scenes, a vectorised judge;
+- hypotheses.py — goals as hypotheses of the Bayesian learner and as hidden intentions;
+- learner.py — ``lang-<signal>``; explain.py — sentences to goals (``hypotheses --explain``).
+"""

@@ -1,0 +1,1017 @@
+"""A goal language: typed, compositional expressions over world states.
+
+An expression (a *goal*) is one or two clauses, optionally with "every other block stays
+where it is". A clause is either
+
+- ``Each``: a quantifier, a selector of blocks and a per-block relation
+  ("every warm-coloured block is in a bowl of its own colour", "no block is left of the red
+  bowl", "exactly two blocks are in the blue bowl"), or
+- ``Form``: a structure over the selected group ("the cool-coloured blocks form one tower,
+  bottom to top in rainbow order").
+
+Selectors, relations and structures are *node types* held in :data:`NODES`; adding one is a
+single :func:`register` call (see ``examples/my_relation.py``). Every node type lists its
+parameter choices; the description length of an expression is the sum over its nodes of
+log2(number of choices at that node) — a uniform choice everywhere, nothing else — and the
+prior of the learner is 2^-bits.
+
+Selectors depend only on the scene (colours of the blocks and of the bowls present), never on
+positions, so the group of a clause is fixed for a scene. A relation that names a block
+("next to the red block") leaves that block out of the group.
+
+Everything judges :class:`~activeintent.learners.bayes.facts.Facts` (relations of one state,
+computed once and shared by all expressions).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from itertools import combinations
+
+import numpy as np
+
+from activeintent.learners.bayes.facts import ALIGN_TOL, Facts, facts
+from activeintent.learners.bayes.planning import GRID
+from activeintent.world import BLOCK_SIZE, PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState
+from activeintent.world.colors import COLOR_NAMES, COOL_COLORS, WARM_COLORS
+from activeintent.world.relations import table_position_name
+from activeintent.world.scene import ALL_OBJECTS, color_of, footprint_radius, kind_of
+
+Group = tuple[str, ...]
+RAINBOW = ("red", "orange", "yellow", "green", "cyan", "blue", "purple", "pink", "brown", "gray")
+MIN_SPACING = 0.03  # centres of neighbours in a row/column are at least this far apart
+
+
+def own_bowl(block: str) -> str:
+    return f"{color_of(block)} bowl"
+
+
+def free_points(state: WorldState, pts: Iterable[tuple[float, float]], b: str, n: int = 6) -> list[Skill]:
+    """PutAt skills to the first ``n`` points of ``pts`` (the planner checks they are free)."""
+    return [PutAt(block=b, position=p) for p in list(pts)[:n]]
+
+
+def _near_first(state: WorldState, b: str, pts: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    x, y = state.pos(b)[:2]
+    return sorted(pts, key=lambda p: (p[0] - x) ** 2 + (p[1] - y) ** 2)
+
+
+# ---- node types -----------------------------------------------------------------------
+
+
+class Node:
+    """A node type of the grammar: a key, a kind and its parameter choices."""
+
+    kind: str = ""
+    key: str = ""
+    params: tuple[str, ...] = ("",)
+
+    def bits(self) -> float:
+        """log2 of the choices below the kind: which type of node, then which parameter."""
+        return math.log2(len(NODES[self.kind])) + math.log2(len(self.params))
+
+
+class Selector(Node):
+    """Which blocks a clause is about. ``pick`` sees a block and the scene's bowls only."""
+
+    kind = "selector"
+
+    def noun(self, p: str) -> str:  # singular, e.g. "warm-coloured block"
+        raise NotImplementedError
+
+    def pick(self, block: str, bowls: tuple[str, ...], p: str) -> bool:
+        raise NotImplementedError
+
+
+class Relation(Node):
+    """A property of one block in a state."""
+
+    kind = "relation"
+
+    def phrase(self, p: str) -> str:  # after "is", e.g. "in a bowl of its own colour"
+        raise NotImplementedError
+
+    def ok(self, f: Facts, b: str, p: str) -> bool:
+        raise NotImplementedError
+
+    def refers(self, p: str) -> str | None:
+        """The object the relation names (it must be in the scene; a named block is not in the group)."""
+        return None
+
+    def possible(self, b: str, objects: tuple[str, ...], p: str) -> bool:
+        """Static check: can ``b`` be made to satisfy the relation in a scene of ``objects``?"""
+        r = self.refers(p)
+        return r is None or (r in objects and r != b)
+
+    def targets(self, state: WorldState, b: str, p: str) -> list[Skill]:
+        """Suggested skills that may make ``b`` satisfy the relation (the planner tries them first)."""
+        return []
+
+
+class Structure(Node):
+    """A shape the whole group takes."""
+
+    kind = "structure"
+    min_size = 2
+
+    def sentence(self, subject: str, p: str) -> str:  # subject: "the warm-coloured blocks"
+        raise NotImplementedError
+
+    def holds(self, f: Facts, g: Group, p: str) -> bool:
+        raise NotImplementedError
+
+    def score(self, f: Facts, g: Group, p: str) -> float:
+        return float(self.holds(f, g, p))
+
+    def moved_ok(self, fb: Facts, fa: Facts, g: Group, b: str, p: str) -> bool:
+        return True
+
+    def possible(self, g: Group, objects: tuple[str, ...], p: str) -> bool:
+        return len(g) >= self.min_size
+
+    def suggest(self, state: WorldState, g: Group, p: str) -> list[Skill]:
+        return []
+
+
+NODES: dict[str, dict[str, Node]] = {"selector": {}, "relation": {}, "structure": {}}
+
+
+def register(node: Node) -> Node:
+    """Add a node type to the language (selector, relation or structure)."""
+    if node.kind not in NODES:
+        raise ValueError(f"unknown node kind {node.kind!r}; valid: {', '.join(NODES)}")
+    if not node.key or " " in node.key or "|" in node.key:
+        raise ValueError(f"a node key is one word without '|', got {node.key!r}")
+    NODES[node.kind][node.key] = node
+    return node
+
+
+# ---- selectors ---------------------------------------------------------------------------
+
+
+class AllBlocks(Selector):
+    key = "all"
+
+    def noun(self, p):
+        return "block"
+
+    def pick(self, block, bowls, p):
+        return True
+
+
+class ColourBlock(Selector):
+    key = "colour"
+    params = COLOR_NAMES
+
+    def noun(self, p):
+        return f"{p} block"
+
+    def pick(self, block, bowls, p):
+        return color_of(block) == p
+
+
+class ColourClass(Selector):
+    key = "class"
+    params = ("warm", "cool")
+
+    def noun(self, p):
+        return f"{p}-coloured block"
+
+    def pick(self, block, bowls, p):
+        return color_of(block) in (WARM_COLORS if p == "warm" else COOL_COLORS)
+
+
+class BowlMatch(Selector):
+    key = "matching"
+    params = ("yes", "no")
+
+    def noun(self, p):
+        return "block whose colour matches a bowl" if p == "yes" else "block whose colour matches no bowl"
+
+    def pick(self, block, bowls, p):
+        return (own_bowl(block) in bowls) == (p == "yes")
+
+
+# ---- relations ---------------------------------------------------------------------------
+
+
+class InBowl(Relation):
+    key = "in-bowl"
+    params = ("any", "same", "other")
+
+    def phrase(self, p):
+        return {"any": "in a bowl", "same": "in the bowl of its own colour",
+                "other": "in a bowl of another colour"}[p]
+
+    def _fits(self, b, w, p):
+        return p == "any" or (color_of(w) == color_of(b)) == (p == "same")
+
+    def ok(self, f, b, p):
+        w = f.bowl_of[b]
+        return w is not None and self._fits(b, w, p)
+
+    def possible(self, b, objects, p):
+        return any(kind_of(o) == "bowl" and self._fits(b, o, p) for o in objects)
+
+    def targets(self, state, b, p):
+        return [PutIn(block=b, bowl=w) for w in state.bowls if self._fits(b, w, p)]
+
+
+class InNamedBowl(Relation):
+    key = "in-the-bowl"
+    params = COLOR_NAMES
+
+    def phrase(self, p):
+        return f"in the {p} bowl"
+
+    def refers(self, p):
+        return f"{p} bowl"
+
+    def ok(self, f, b, p):
+        return f.bowl_of[b] == f"{p} bowl"
+
+    def targets(self, state, b, p):
+        return [PutIn(block=b, bowl=f"{p} bowl")]
+
+
+class OnBlock(Relation):
+    key = "on-block"
+    params = ("any",)
+
+    def phrase(self, p):
+        return "on top of another block"
+
+    def ok(self, f, b, p):
+        return f.below[b] is not None
+
+    def possible(self, b, objects, p):
+        return sum(kind_of(o) == "block" for o in objects) >= 2
+
+    def targets(self, state, b, p):
+        f = facts(state)
+        return [PutOn(block=b, target=o) for o in state.blocks if o != b and f.clear(o)]
+
+
+class OnNamedBlock(Relation):
+    key = "on-the-block"
+    params = COLOR_NAMES
+
+    def phrase(self, p):
+        return f"on the {p} block"
+
+    def refers(self, p):
+        return f"{p} block"
+
+    def ok(self, f, b, p):
+        return f.below[b] == f"{p} block"
+
+    def targets(self, state, b, p):
+        return [PutOn(block=b, target=f"{p} block")]
+
+
+class OnTable(Relation):
+    key = "on-table"
+
+    def phrase(self, p):
+        return "flat on the table (not in a bowl, not on a block)"
+
+    def ok(self, f, b, p):
+        return b in f.on_table and f.below[b] is None
+
+    def targets(self, state, b, p):
+        return free_points(state, _near_first(state, b, GRID), b, 8)
+
+
+class NextTo(Relation):
+    key = "next-to"
+    params = ALL_OBJECTS + ("own-bowl",)
+
+    def phrase(self, p):
+        return "next to the bowl of its own colour" if p == "own-bowl" else f"next to the {p}"
+
+    def refers(self, p):
+        return None if p == "own-bowl" else p
+
+    def _target(self, b, p):
+        return own_bowl(b) if p == "own-bowl" else p
+
+    def ok(self, f, b, p):
+        return f.next_to(b, self._target(b, p))
+
+    def possible(self, b, objects, p):
+        t = self._target(b, p)
+        return t in objects and t != b
+
+    def targets(self, state, b, p):
+        t = self._target(b, p)
+        return [PutNextTo(block=b, target=t, side=s) for s in ("nearest", "left", "right", "front", "behind")]
+
+
+SIDES = ("left", "right", "front", "behind")
+SIDE_WORDS = {"left": "left of", "right": "right of", "front": "in front of", "behind": "behind"}
+
+
+class Beside(Relation):
+    """Entirely on one side of an object (left/right along x, front/behind along y), not in a bowl."""
+
+    key = "side"
+    params = tuple(f"{s}/{o}" for s in SIDES for o in ALL_OBJECTS)
+
+    def phrase(self, p):
+        s, o = p.split("/")
+        return f"{SIDE_WORDS[s]} the {o}"
+
+    def refers(self, p):
+        return p.split("/")[1]
+
+    @staticmethod
+    def beyond(xy_b, xy_o, o: str, s: str) -> bool:
+        reach = footprint_radius(o) + BLOCK_SIZE / 2 - 0.004
+        dx, dy = xy_b[0] - xy_o[0], xy_b[1] - xy_o[1]
+        return {"left": -dx, "right": dx, "front": -dy, "behind": dy}[s] >= reach
+
+    def ok(self, f, b, p):
+        s, o = p.split("/")
+        return f.bowl_of[b] is None and self.beyond(f.xy[b], f.xy[o], o, s)
+
+    def targets(self, state, b, p):
+        s, o = p.split("/")
+        xy_o = state.pos(o)[:2]
+        pts = [q for q in GRID if self.beyond(q, xy_o, o, s)]
+        return [PutNextTo(block=b, target=o, side=s)] + free_points(state, _near_first(state, o, pts), b, 5)
+
+
+def _cell(name: str):
+    return lambda xy: table_position_name(xy) == name
+
+
+REGIONS = {
+    "left half": lambda xy: xy[0] < 0.0,
+    "right half": lambda xy: xy[0] > 0.0,
+    "back half": lambda xy: xy[1] > -0.5,
+    "front half": lambda xy: xy[1] < -0.5,
+    "back strip": lambda xy: xy[1] > -0.4,
+    "front strip": lambda xy: xy[1] < -0.6,
+    "centre": lambda xy: abs(xy[0]) < 0.1 and abs(xy[1] + 0.5) < 0.1,
+    "back left corner": _cell("top left corner"),
+    "back right corner": _cell("top right corner"),
+    "front left corner": _cell("bottom left corner"),
+    "front right corner": _cell("bottom right corner"),
+}
+
+
+def region_points(region: str) -> list[tuple[float, float]]:
+    inside = REGIONS[region]
+    pts = [q for q in GRID if inside(q)]
+    cx, cy = float(np.mean([q[0] for q in pts])), float(np.mean([q[1] for q in pts]))
+    return sorted(pts, key=lambda q: (q[0] - cx) ** 2 + (q[1] - cy) ** 2)
+
+
+class InRegion(Relation):
+    key = "region"
+    params = tuple(REGIONS)
+
+    def phrase(self, p):
+        return f"in the {p} of the table (front = near the person, back = far side; not in a bowl)"
+
+    def ok(self, f, b, p):
+        return b in f.on_table and f.below[b] is None and REGIONS[p](f.xy[b])
+
+    def targets(self, state, b, p):
+        return free_points(state, region_points(p), b, 10)
+
+
+# ---- structures --------------------------------------------------------------------------
+
+
+def _rank(b: str) -> int:
+    return RAINBOW.index(color_of(b))
+
+
+def _flat(f: Facts, b: str) -> bool:
+    return b in f.on_table and f.below[b] is None and f.above[b] is None
+
+
+class Line(Structure):
+    """A straight row (axis 1: same y, along x) or column (axis 0: same x, along y) of flat
+    blocks, neighbours next to each other; ``rainbow``: in rainbow order left→right / front→back."""
+
+    params = ("any", "rainbow")
+    axis = 1
+    sides = ("right", "left")
+    words = ("one left-to-right row", "left to right")
+
+    def sentence(self, subject, p):
+        text = f"{subject} form {self.words[0]} on the table, each next to its neighbour"
+        return text + (f", in rainbow order {self.words[1]}" if p == "rainbow" else "")
+
+    def line(self, f: Facts, blocks, p: str) -> bool:
+        if len(blocks) < 1 or not all(_flat(f, b) for b in blocks):
+            return False
+        across = [f.xy[b][self.axis] for b in blocks]
+        if max(across) - min(across) > ALIGN_TOL:
+            return False
+        along = sorted(blocks, key=lambda b: f.xy[b][1 - self.axis])
+        if p == "rainbow" and along != sorted(blocks, key=_rank):
+            return False
+        return all(f.xy[b][1 - self.axis] - f.xy[a][1 - self.axis] >= MIN_SPACING and f.next_to(a, b)
+                   for a, b in zip(along, along[1:], strict=False))
+
+    def holds(self, f, g, p):
+        return self.line(f, g, p)
+
+    def best(self, f: Facts, g: Group, p: str) -> tuple[str, ...]:
+        flat = [b for b in g if _flat(f, b)]
+        for size in range(len(flat), 1, -1):
+            for c in combinations(flat, size):
+                if self.line(f, c, p):
+                    return c
+        return tuple(flat[:1])
+
+    def score(self, f, g, p):
+        return len(self.best(f, g, p)) / len(g) if g else 1.0
+
+    def moved_ok(self, fb, fa, g, b, p):
+        if not _flat(fa, b):
+            return False
+        v = fa.xy[b][self.axis]
+        near = [o for o in g if o != b and _flat(fa, o) and fa.next_to(b, o)]
+        return not near or any(abs(fa.xy[o][self.axis] - v) <= ALIGN_TOL for o in near)
+
+    def suggest(self, state, g, p):
+        f = facts(state)
+        chain = sorted(self.best(f, g, p), key=lambda b: f.xy[b][1 - self.axis])
+        rest = [b for b in g if b not in chain]
+        if not chain:
+            return []
+        lo, hi = chain[0], chain[-1]
+        out: list[Skill] = []
+        for b in sorted(rest, key=_rank) if p == "rainbow" else rest:
+            out += [PutNextTo(block=b, target=hi, side=self.sides[0]), PutNextTo(block=b, target=lo, side=self.sides[1])]
+        return out
+
+
+class Row(Line):
+    key = "row"
+
+
+class Column(Line):
+    key = "column"
+    axis = 0
+    sides = ("behind", "front")
+    words = ("one front-to-back column", "front to back")
+
+
+def _towers(f: Facts, g: Group) -> list[list[str]]:
+    """Towers made only of group blocks (a lone block is a tower of height 1), bottom to top."""
+    gs = set(g)
+    out = []
+    for b in g:
+        if f.below[b] is None:
+            chain = f.tower(b)
+            if all(c in gs for c in chain):
+                out.append(chain)
+    return sorted(out, key=len, reverse=True)
+
+
+def _ordered_height(f: Facts, g: Group) -> int:
+    """How many blocks of the rainbow-ordered group already stand in order from the bottom."""
+    want = sorted(g, key=_rank)
+    if f.below[want[0]] is not None:
+        return 0
+    chain = f.tower(want[0])
+    n = 0
+    while n < len(chain) and n < len(want) and chain[n] == want[n]:
+        n += 1
+    return n
+
+
+class Tower(Structure):
+    key = "tower"
+    params = ("any", "rainbow")
+
+    def sentence(self, subject, p):
+        return f"{subject} are stacked into one tower" + (
+            " in rainbow order from the bottom up" if p == "rainbow" else "")
+
+    def holds(self, f, g, p):
+        if p == "rainbow":
+            return _ordered_height(f, g) == len(g) and f.above[sorted(g, key=_rank)[-1]] is None
+        t = _towers(f, g)
+        return bool(t) and len(t[0]) == len(g)
+
+    def score(self, f, g, p):
+        if p == "rainbow":
+            return _ordered_height(f, g) / len(g)
+        t = _towers(f, g)
+        return len(t[0]) / len(g) if t else 0.0
+
+    def moved_ok(self, fb, fa, g, b, p):
+        return fa.below[b] is not None or len(g) == 1
+
+    def suggest(self, state, g, p):
+        f = facts(state)
+        if p == "rainbow":
+            want = sorted(g, key=_rank)
+            n = _ordered_height(f, g)
+            if n == 0:
+                return free_points(state, _near_first(state, want[0], GRID), want[0], 6)
+            return [PutOn(block=want[n], target=want[n - 1])] if n < len(want) else []
+        t = _towers(f, g)
+        out: list[Skill] = []
+        for tower in t[:2]:
+            out += [PutOn(block=b, target=tower[-1]) for b in g if b not in tower]
+        return out
+
+
+class TowersByClass(Structure):
+    key = "towers-by-class"
+    min_size = 2
+
+    def sentence(self, subject, p):
+        return f"{subject} form two towers: one of the warm-coloured blocks and one of the cool-coloured ones"
+
+    @staticmethod
+    def parts(g):
+        warm = tuple(b for b in g if color_of(b) in WARM_COLORS)
+        return [x for x in (warm, tuple(b for b in g if b not in warm)) if x]
+
+    def holds(self, f, g, p):
+        return all(Tower().holds(f, part, "any") for part in self.parts(g))
+
+    def score(self, f, g, p):
+        return sum(Tower().score(f, part, "any") * len(part) for part in self.parts(g)) / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        part = next(x for x in self.parts(g) if b in x)
+        return len(part) == 1 or (fa.below[b] is not None and fa.below[b] in part)
+
+    def possible(self, g, objects, p):
+        return len(self.parts(g)) == 2 and len(g) >= 3
+
+    def suggest(self, state, g, p):
+        return [s for part in self.parts(g) for s in Tower().suggest(state, part, "any")]
+
+
+class TwoTowers(Structure):
+    key = "two-towers"
+    min_size = 3
+
+    def sentence(self, subject, p):
+        return f"{subject} are stacked into two towers of (nearly) equal height"
+
+    def holds(self, f, g, p):
+        t = _towers(f, g)
+        return len(t) == 2 and (len(t[0]), len(t[1])) == ((len(g) + 1) // 2, len(g) // 2)
+
+    def score(self, f, g, p):
+        t = _towers(f, g)
+        want = ((len(g) + 1) // 2, len(g) // 2)
+        got = sum(min(len(x), w) for x, w in zip(t[:2], want, strict=False))
+        return got / len(g) if len(t) >= 2 else min(len(t[0]) if t else 0, want[0]) / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        return fa.below[b] is not None
+
+    def suggest(self, state, g, p):
+        t = _towers(facts(state), g)
+        return [PutOn(block=b, target=tower[-1]) for tower in t[:2] for b in g if b not in tower]
+
+
+class OneBowl(Structure):
+    key = "one-bowl"
+    min_size = 2
+
+    def sentence(self, subject, p):
+        return f"{subject} all go together in one bowl"
+
+    def _counts(self, f, g):
+        c: dict[str, int] = {}
+        for b in g:
+            if (w := f.bowl_of[b]) is not None:
+                c[w] = c.get(w, 0) + 1
+        return c
+
+    def holds(self, f, g, p):
+        return f.bowl_of[g[0]] is not None and all(f.bowl_of[b] == f.bowl_of[g[0]] for b in g)
+
+    def score(self, f, g, p):
+        return max(self._counts(f, g).values(), default=0) / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        c = self._counts(fa, g)
+        return fa.bowl_of[b] is not None and c[fa.bowl_of[b]] == max(c.values())
+
+    def possible(self, g, objects, p):
+        return len(g) >= 2 and any(kind_of(o) == "bowl" for o in objects)
+
+    def suggest(self, state, g, p):
+        c = self._counts(facts(state), g)
+        bowls = sorted(state.bowls, key=lambda w: -c.get(w, 0))
+        return [PutIn(block=b, bowl=w) for w in bowls for b in g]
+
+
+class SeparateBowls(Structure):
+    key = "separate-bowls"
+    min_size = 1
+
+    def sentence(self, subject, p):
+        return f"{subject} go in bowls, one block per bowl"
+
+    def _ok(self, f, g, b):
+        w = f.bowl_of[b]
+        return w is not None and not any(o != b and f.bowl_of[o] == w for o in g)
+
+    def holds(self, f, g, p):
+        return all(self._ok(f, g, b) for b in g)
+
+    def score(self, f, g, p):
+        return sum(self._ok(f, g, b) for b in g) / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        return self._ok(fa, g, b)
+
+    def possible(self, g, objects, p):
+        return 1 <= len(g) <= sum(kind_of(o) == "bowl" for o in objects)
+
+    def suggest(self, state, g, p):
+        f = facts(state)
+        used = {f.bowl_of[b] for b in g}
+        return [PutIn(block=b, bowl=w) for b in g if not self._ok(f, g, b) for w in state.bowls if w not in used]
+
+
+class Cluster(Structure):
+    key = "cluster"
+
+    def sentence(self, subject, p):
+        return f"{subject} are grouped together on the table, each touching another"
+
+    def _comp(self, f, g, start):
+        seen, todo = {start}, [start]
+        while todo:
+            a = todo.pop()
+            for o in g:
+                if o not in seen and _flat(f, o) and f.next_to(a, o):
+                    seen.add(o)
+                    todo.append(o)
+        return seen
+
+    def holds(self, f, g, p):
+        return all(_flat(f, b) for b in g) and len(self._comp(f, g, g[0])) == len(g)
+
+    def score(self, f, g, p):
+        return max((len(self._comp(f, g, b)) for b in g if _flat(f, b)), default=0) / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        return _flat(fa, b)
+
+    def suggest(self, state, g, p):
+        f = facts(state)
+        flat = [b for b in g if _flat(f, b)]
+        if not flat:
+            return []
+        core = max((self._comp(f, g, b) for b in flat), key=len)
+        return [PutNextTo(block=b, target=t) for b in g if b not in core for t in core]
+
+
+CORNERS = ("back left corner", "back right corner", "front left corner", "front right corner")
+
+
+class Corners(Structure):
+    key = "corners"
+    min_size = 1
+
+    def sentence(self, subject, p):
+        return f"{subject} go on the table, each in a different corner"
+
+    def _corner(self, f, b):
+        if b not in f.on_table or f.below[b] is not None:
+            return None
+        return next((c for c in CORNERS if REGIONS[c](f.xy[b])), None)
+
+    def _ok(self, f, g, b):
+        c = self._corner(f, b)
+        return c is not None and all(self._corner(f, o) != c for o in g if o != b)
+
+    def holds(self, f, g, p):
+        return all(self._ok(f, g, b) for b in g)
+
+    def score(self, f, g, p):
+        return sum(self._ok(f, g, b) for b in g) / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        return self._ok(fa, g, b)
+
+    def possible(self, g, objects, p):
+        return 1 <= len(g) <= 4
+
+    def suggest(self, state, g, p):
+        f = facts(state)
+        taken = {self._corner(f, o) for o in g}
+        out: list[Skill] = []
+        for b in g:
+            if not self._ok(f, g, b):
+                for c in CORNERS:
+                    if c not in taken:
+                        out += free_points(state, region_points(c), b, 3)
+        return out
+
+
+for _node in (AllBlocks(), ColourBlock(), ColourClass(), BowlMatch(),
+              InBowl(), InNamedBowl(), OnBlock(), OnNamedBlock(), OnTable(), NextTo(), Beside(), InRegion(),
+              Row(), Column(), Tower(), TowersByClass(), TwoTowers(), OneBowl(), SeparateBowls(), Cluster(),
+              Corners()):
+    register(_node)
+
+
+# ---- quantifiers ---------------------------------------------------------------------------
+
+QUANTS = ("every", "none", "exactly-1", "exactly-2", "at-least-1", "at-least-2")
+NUMBER = {"1": "one", "2": "two"}
+
+
+def quant_holds(q: str, cnt, size):
+    """Works on ints and on numpy arrays alike."""
+    if q == "every":
+        return cnt == size
+    if q == "none":
+        return cnt == 0
+    n = int(q[-1])
+    return cnt == n if q.startswith("exactly") else cnt >= n
+
+
+def quant_score(q: str, cnt, size):
+    size = np.maximum(size, 1)
+    if q == "every":
+        return cnt / size
+    if q == "none":
+        return 1.0 - cnt / size
+    n = int(q[-1])
+    if q.startswith("exactly"):
+        return np.clip(1.0 - np.abs(cnt - n) / np.maximum(size, n), 0.0, 1.0)
+    return np.minimum(cnt, n) / n
+
+
+# ---- clauses and goals ------------------------------------------------------------------------
+
+
+def _groups(f: Facts) -> dict:
+    g = f.memo.get("lang-groups")
+    if g is None:
+        g = f.memo["lang-groups"] = {}
+    return g
+
+
+@dataclass(frozen=True)
+class Each:
+    """``quant`` of the blocks picked by ``sel:sp`` satisfy ``rel:rp``."""
+
+    quant: str
+    sel: str
+    sp: str
+    rel: str
+    rp: str
+
+    @property
+    def key(self) -> str:
+        return f"{self.quant} {self.sel}:{self.sp} {self.rel}:{self.rp}"
+
+    @property
+    def bits(self) -> float:
+        return 1 + math.log2(len(QUANTS)) + NODES["selector"][self.sel].bits() + NODES["relation"][self.rel].bits()
+
+    @property
+    def relation(self) -> Relation:
+        return NODES["relation"][self.rel]  # type: ignore[return-value]
+
+    def group(self, blocks, bowls) -> Group:
+        sel = NODES["selector"][self.sel]
+        skip = self.relation.refers(self.rp)
+        return tuple(b for b in blocks if b != skip and sel.pick(b, tuple(bowls), self.sp))  # type: ignore[attr-defined]
+
+    def group_f(self, f: Facts) -> Group:
+        memo = _groups(f)
+        got = memo.get(self.key)
+        if got is None:
+            got = memo[self.key] = self.group(f.blocks, f.bowls)
+        return got
+
+    def sentence(self) -> str:
+        sel: Selector = NODES["selector"][self.sel]  # type: ignore[assignment]
+        noun = sel.noun(self.sp)
+        if self.relation.refers(self.rp) and self.sel == "all":
+            noun = "other block"
+        rel = self.relation.phrase(self.rp)
+        if self.quant == "every":
+            return f"every {noun} is {rel}"
+        if self.quant == "none":
+            return f"no {noun} is {rel}"
+        n = NUMBER[self.quant[-1]]
+        many = noun.replace("block", "blocks", 1) if n != "one" else noun
+        verb = "is" if n == "one" else "are"
+        return f"{'exactly' if self.quant.startswith('exactly') else 'at least'} {n} {many} {verb} {rel}"
+
+    def count(self, f: Facts) -> tuple[int, int]:
+        """(blocks of the group satisfying the relation, group size); a relation naming an
+        object that is not on the table holds for no block."""
+        g = self.group_f(f)
+        ref = self.relation.refers(self.rp)
+        if ref is not None and ref not in f.pos:
+            return 0, len(g)
+        return sum(self.relation.ok(f, b, self.rp) for b in g), len(g)
+
+    def holds(self, f: Facts) -> bool:
+        return bool(quant_holds(self.quant, *self.count(f)))
+
+    def score(self, f: Facts) -> float:
+        return float(quant_score(self.quant, *self.count(f)))
+
+    def moved_off(self, fb: Facts, fa: Facts, b: str) -> bool:
+        g = self.group_f(fa)
+        if b not in g:
+            return False
+        ref = self.relation.refers(self.rp)
+        ok = (ref is None or ref in fa.pos) and self.relation.ok(fa, b, self.rp)
+        if self.quant == "every":
+            return not ok
+        if self.quant == "none":
+            return ok
+        if self.quant.startswith("exactly"):
+            return ok and self.count(fa)[0] > int(self.quant[-1])
+        return False
+
+    def possible(self, objects: tuple[str, ...]) -> bool:
+        r = self.relation.refers(self.rp)
+        if r is not None and r not in objects:
+            return False
+        g = self.group([o for o in objects if kind_of(o) == "block"], [o for o in objects if kind_of(o) == "bowl"])
+        if not g:
+            return False
+        can = sum(self.relation.possible(b, objects, self.rp) for b in g)
+        if self.quant == "every":
+            return can == len(g)
+        if self.quant == "none":
+            return True
+        return can >= int(self.quant[-1])
+
+    def suggest(self, state: WorldState, f: Facts) -> list[Skill]:
+        g = self.group_f(f)
+        out: list[Skill] = []
+        if self.quant == "none" or (self.quant.startswith("exactly") and self.count(f)[0] > int(self.quant[-1])):
+            for b in g:
+                if self.relation.ok(f, b, self.rp):
+                    out += OnTable().targets(state, b, "")[:4] + [PutIn(block=b, bowl=w) for w in state.bowls]
+            return out
+        for b in g:
+            if not self.relation.ok(f, b, self.rp):
+                out += self.relation.targets(state, b, self.rp)
+        return out
+
+
+@dataclass(frozen=True)
+class Form:
+    """The blocks picked by ``sel:sp`` take the shape ``struct:stp``."""
+
+    struct: str
+    stp: str
+    sel: str
+    sp: str
+
+    @property
+    def key(self) -> str:
+        return f"form {self.struct}:{self.stp} {self.sel}:{self.sp}"
+
+    @property
+    def bits(self) -> float:
+        return 1 + NODES["structure"][self.struct].bits() + NODES["selector"][self.sel].bits()
+
+    @property
+    def structure(self) -> Structure:
+        return NODES["structure"][self.struct]  # type: ignore[return-value]
+
+    def group(self, blocks, bowls) -> Group:
+        sel = NODES["selector"][self.sel]
+        return tuple(b for b in blocks if sel.pick(b, tuple(bowls), self.sp))  # type: ignore[attr-defined]
+
+    def group_f(self, f: Facts) -> Group:
+        memo = _groups(f)
+        k = ("form", self.sel, self.sp)
+        got = memo.get(k)
+        if got is None:
+            got = memo[k] = self.group(f.blocks, f.bowls)
+        return got
+
+    def sentence(self) -> str:
+        sel: Selector = NODES["selector"][self.sel]  # type: ignore[assignment]
+        noun = sel.noun(self.sp).replace("block", "blocks", 1)
+        return self.structure.sentence(f"the {noun}", self.stp)
+
+    def _judge(self, f: Facts) -> tuple[bool, float]:
+        k = ("form-judge", self.struct, self.stp, self.group_f(f))
+        got = f.memo.get(k)
+        if got is None:
+            g = self.group_f(f)
+            got = f.memo[k] = ((True, 1.0) if not g else
+                               (self.structure.holds(f, g, self.stp), float(self.structure.score(f, g, self.stp))))
+        return got
+
+    def holds(self, f: Facts) -> bool:
+        return self._judge(f)[0]
+
+    def score(self, f: Facts) -> float:
+        return self._judge(f)[1]
+
+    def moved_off(self, fb: Facts, fa: Facts, b: str) -> bool:
+        g = self.group_f(fa)
+        return b in g and not self.structure.moved_ok(fb, fa, g, b, self.stp)
+
+    def possible(self, objects: tuple[str, ...]) -> bool:
+        g = self.group([o for o in objects if kind_of(o) == "block"], [o for o in objects if kind_of(o) == "bowl"])
+        return bool(g) and self.structure.possible(g, objects, self.stp)
+
+    def suggest(self, state: WorldState, f: Facts) -> list[Skill]:
+        return self.structure.suggest(state, self.group_f(f), self.stp)
+
+
+Clause = Each | Form
+
+
+@dataclass(frozen=True)
+class Goal:
+    """One or two clauses; ``stays``: every block outside the clauses' groups keeps its place."""
+
+    clauses: tuple[Clause, ...]
+    stays: bool = False
+    _bits: float = field(default=-1.0, compare=False, repr=False)
+
+    @property
+    def key(self) -> str:
+        return " & ".join(c.key for c in self.clauses) + (" & stays" if self.stays else "")
+
+    @property
+    def bits(self) -> float:
+        """1 bit for one/two clauses, 1 bit for the stays flag, the clauses; −1 for two
+        clauses since either order says the same."""
+        return 2 + sum(c.bits for c in self.clauses) - (1 if len(self.clauses) == 2 else 0)
+
+    def sentence(self) -> str:
+        parts = [c.sentence() for c in self.clauses]
+        text = ", and ".join(parts)
+        if self.stays:
+            text += "; every other block stays where it is"
+        return text[0].upper() + text[1:] + "."
+
+    def groups(self, f: Facts) -> set[str]:
+        return {b for c in self.clauses for b in c.group_f(f)}
+
+    def holds(self, f: Facts) -> bool:
+        return all(c.holds(f) for c in self.clauses)
+
+    def score(self, f: Facts) -> float:
+        return sum(c.score(f) for c in self.clauses) / len(self.clauses)
+
+    def moved_off(self, fb: Facts, fa: Facts, b: str) -> bool:
+        if self.stays and b not in self.groups(fa):
+            return True
+        return any(c.moved_off(fb, fa, b) for c in self.clauses)
+
+    def possible(self, objects: tuple[str, ...]) -> bool:
+        return all(c.possible(tuple(objects)) for c in self.clauses)
+
+
+def parse_clause(key: str) -> Clause:
+    """Inverse of ``Clause.key``."""
+    parts = key.split(" ")
+    if parts[0] == "form":
+        struct, stp = parts[1].split(":", 1)
+        sel, sp = parts[2].split(":", 1)
+        return Form(struct, stp, sel, sp)
+    sel, sp = parts[1].split(":", 1)
+    rel, rp = " ".join(parts[2:]).split(":", 1)
+    return Each(parts[0], sel, sp, rel, rp)
+
+
+def parse_goal(key: str) -> Goal:
+    """Inverse of ``Goal.key``."""
+    items = key.split(" & ")
+    stays = items[-1] == "stays"
+    if stays:
+        items = items[:-1]
+    return Goal(tuple(parse_clause(k) for k in items), stays)
+
+
+def all_clauses() -> list[Clause]:
+    """Every clause of the language (each node type with each of its parameters)."""
+    out: list[Clause] = []
+    for sel, snode in NODES["selector"].items():
+        for sp in snode.params:
+            for rel, rnode in NODES["relation"].items():
+                for rp in rnode.params:
+                    for q in QUANTS:
+                        out.append(Each(q, sel, sp, rel, rp))
+            for st, stnode in NODES["structure"].items():
+                for stp in stnode.params:
+                    out.append(Form(st, stp, sel, sp))
+    return out

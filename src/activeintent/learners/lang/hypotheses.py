@@ -1,0 +1,151 @@
+"""Goals of the language as hypotheses of the Bayesian learner, and as hidden intentions.
+
+:class:`LangHypothesis` has the interface of ``bayes.hypotheses.Hypothesis`` (``bits``,
+``description``, ``name``, ``holds_f``, ``score_f``, ``moved_off``, ``feasible``, ``plans``,
+``plan``, ``prefetch``), so ``bayes.judge``, ``candidates``, ``belief``, ``acquisition`` and
+``BayesLearner`` use it unchanged. All hypotheses of one :class:`LangSpace` share a
+:class:`~activeintent.learners.lang.space.Compiled` judge: the first hypothesis asked about a
+state judges every goal at once (numpy), the others read the memo.
+
+Feasibility in a scene is the static check of the goal's nodes (named objects present, group
+not empty, enough bowls, …) and, once the planner has been run for the goal in that scene, its
+verdict: a scene in which the planner failed is infeasible from then on.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+
+import numpy as np
+
+from activeintent.intentions.base import Intention
+from activeintent.learners.bayes.facts import Facts, facts
+from activeintent.learners.bayes.hypotheses import Hypothesis, random_scene
+from activeintent.learners.lang import planner
+from activeintent.learners.lang.expr import Goal
+from activeintent.learners.lang.space import Compiled, goal_space
+from activeintent.world import Scene, Skill, WorldState
+
+
+class LangSpace:
+    """A tuple of goals, their shared vectorised judge and the planner verdicts so far."""
+
+    def __init__(self, goals: list[Goal] | tuple[Goal, ...], variants: int = 2):
+        self.goals = tuple(goals)
+        self.compiled = Compiled(list(self.goals))
+        self.variants = variants
+        self.failed: dict[tuple[str, ...], set[int]] = {}
+        self._feasible: dict[tuple[str, ...], tuple[int, np.ndarray]] = {}
+        self._plans: OrderedDict[tuple, list[list[Skill]]] = OrderedDict()
+        self.hypotheses = tuple(LangHypothesis(g, self, i) for i, g in enumerate(self.goals))
+
+    def feasible(self, objects: tuple[str, ...]) -> np.ndarray:
+        failed = self.failed.get(objects, set())
+        got = self._feasible.get(objects)
+        if got is None or got[0] != len(failed):
+            arr = self.compiled.possible(objects).copy()
+            arr[list(failed)] = False
+            got = self._feasible[objects] = (len(failed), arr)
+        return got[1]
+
+    def plans(self, i: int, state: WorldState, variants: int | None = None) -> list[list[Skill]]:
+        n = variants or self.variants
+        key = (i, n, tuple(sorted(state.positions.items())))
+        got = self._plans.get(key)
+        if got is not None:
+            return got
+        goal = self.goals[i]
+        out: list[list[Skill]] = []
+        seen: set[str] = set()
+        for v in range(n):
+            p = planner.plan(goal, state, variant=v)
+            if p is None:
+                if v == 0:
+                    self.failed.setdefault(tuple(state.scene.objects), set()).add(i)
+                    break
+                continue
+            k = repr(p)
+            if k not in seen:
+                seen.add(k)
+                out.append(p)
+        self._plans[key] = out
+        if len(self._plans) > 20000:
+            self._plans.popitem(last=False)
+        return out
+
+
+class LangHypothesis(Hypothesis):
+    """One goal of the language, as a hypothesis z (prior 2^-bits)."""
+
+    def __init__(self, goal: Goal, space: LangSpace, index: int):  # noqa: D107 - no clauses of bayes
+        self.goal = goal
+        self.space = space
+        self.index = index
+        self.clauses = ()
+        self.bits = goal.bits
+        self.name = goal.key
+        self.description = goal.sentence()
+
+    def holds_f(self, f: Facts) -> bool:
+        return bool(self.space.compiled.eval(f)[0][self.index])
+
+    def score_f(self, f: Facts) -> float:
+        return float(self.space.compiled.eval(f)[1][self.index])
+
+    def moved_off(self, fb: Facts, fa: Facts, block: str) -> bool:
+        return bool(self.space.compiled.moved_off(fb, fa, block)[self.index])
+
+    def feasible(self, scene: Scene) -> bool:
+        return bool(self.space.feasible(tuple(scene.objects))[self.index])
+
+    def plans(self, state: WorldState, variants: int | None = None) -> list[list[Skill]]:
+        return self.space.plans(self.index, state, variants)
+
+    def plan(self, state: WorldState) -> list[Skill] | None:
+        got = self.plans(state, 1)
+        return got[0] if got else None
+
+
+class GoalIntention(Intention):
+    """A goal as a hidden user intention (tests, and ``--intention-file`` files)."""
+
+    def __init__(self, goal: Goal, name: str | None = None):
+        self.goal = goal
+        self.name = name or "lang:" + goal.key.replace(" ", "_")
+        self.description = goal.sentence()
+
+    def satisfied(self, state: WorldState) -> bool:
+        return self.goal.holds(facts(state))
+
+    def score(self, state: WorldState) -> float:
+        return self.goal.score(facts(state))
+
+    def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
+        if before.positions == after.positions:
+            return False
+        fb, fa = facts(before), facts(after)
+        return self.goal.score(fa) < self.goal.score(fb) - 1e-9 or self.goal.moved_off(fb, fa, step.block)
+
+    def feasible(self, scene: Scene) -> bool:
+        return planner.feasible(self.goal, scene)
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        for _ in range(500):
+            scene = random_scene(rng)
+            if self.feasible(scene):
+                return scene
+        raise ValueError(f"no feasible scene of 3–5 objects for {self.goal.key!r}")
+
+    def plan(self, state: WorldState) -> list[Skill] | None:
+        return planner.plan(self.goal, state)
+
+
+_SPACES: dict[tuple[int, int], LangSpace] = {}
+
+
+def lang_space(seed: int = 0, keep: int = 3000) -> LangSpace:
+    """The language's de-duplicated hypothesis space (built once per process, cached on disk)."""
+    key = (seed, keep)
+    if key not in _SPACES:
+        _SPACES[key] = LangSpace(goal_space(seed, keep))
+    return _SPACES[key]

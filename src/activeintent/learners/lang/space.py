@@ -1,0 +1,348 @@
+"""The hypothesis space of the language: enumeration, behavioural de-duplication, and a
+vectorised judge of thousands of goals at once.
+
+Enumeration: every one-clause goal (with and without "every other block stays where it is")
+and every unordered pair of the simplest distinct clauses. De-duplication: goals are judged on
+a seeded bank of probe scenes — per scene whether the goal can be shown (static check), per
+probe state whether it holds, per probe move whether the move goes against it; goals with the
+same answers everywhere are one (the shortest is kept), goals that hold on no probe state are
+dropped (nothing could confirm them). The ``keep`` shortest distinct goals form the space.
+The list is cached on disk under ``$ACTIVEINTENT_CACHE`` (default ``~/.cache/activeintent``),
+keyed by a hash of the sources it depends on and of the registered node types.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import time
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from activeintent.learners.bayes.facts import Facts, facts
+from activeintent.learners.bayes.hypotheses import random_scene
+from activeintent.learners.lang.expr import NODES, QUANTS, Each, Form, Goal, all_clauses, parse_goal
+from activeintent.learners.lang.planner import generic_moves, plan
+from activeintent.world import WorldState, apply_skill, layout
+from activeintent.world.scene import kind_of
+
+Q_CODE = {"every": 0, "none": 1, "exactly": 2, "at-least": 3}
+
+
+class Compiled:
+    """Judges a fixed list of goals on a state in one go (numpy), memoised on the Facts."""
+
+    def __init__(self, goals: list[Goal]):
+        self.goals = goals
+        index: dict[str, int] = {}
+        clauses = []
+        for g in goals:
+            for c in g.clauses:
+                if c.key not in index:
+                    index[c.key] = len(clauses)
+                    clauses.append(c)
+        self.clauses = clauses
+        n = len(clauses)
+        self.E = np.full((len(goals), max((len(g.clauses) for g in goals), default=1)), n)
+        for i, g in enumerate(goals):
+            for k, c in enumerate(g.clauses):
+                self.E[i, k] = index[c.key]
+        self.valid = self.E < n
+        self.n_clauses = self.valid.sum(1)
+        self.stays = np.array([g.stays for g in goals], bool)
+        self.each = [i for i, c in enumerate(clauses) if isinstance(c, Each)]
+        self.forms = [i for i, c in enumerate(clauses) if isinstance(c, Form)]
+        sels: dict[tuple[str, str], int] = {}
+        rels: dict[tuple[str, str], int] = {}
+        for i in self.each:
+            c = clauses[i]
+            sels.setdefault((c.sel, c.sp), len(sels))
+            rels.setdefault((c.rel, c.rp), len(rels))
+        for i in self.forms:
+            sels.setdefault((clauses[i].sel, clauses[i].sp), len(sels))
+        self.sels, self.rels = list(sels), list(rels)
+        each = [clauses[i] for i in self.each]
+        self.e_sel = np.array([sels[(c.sel, c.sp)] for c in each], int)
+        self.e_rel = np.array([rels[(c.rel, c.rp)] for c in each], int)
+        self.e_q = np.array([Q_CODE[c.quant.rsplit("-", 1)[0] if c.quant[-1].isdigit() else c.quant] for c in each], int)
+        self.e_n = np.array([int(c.quant[-1]) if c.quant[-1].isdigit() else 0 for c in each], int)
+        self.f_sel = np.array([sels[(clauses[i].sel, clauses[i].sp)] for i in self.forms], int)
+        self._possible: dict[tuple[str, ...], np.ndarray] = {}
+        self._tag = ("lang", id(self))
+
+    # -- per state --
+
+    def _matrices(self, f: Facts):
+        key = self._tag + ("m",)
+        got = f.memo.get(key)
+        if got is not None:
+            return got
+        blocks = f.blocks
+        bowls = tuple(f.bowls)
+        objects = set(blocks) | set(bowls)
+        S = np.array([[NODES["selector"][s].pick(b, bowls, p) for b in blocks] for s, p in self.sels], bool)
+        S = S.reshape(len(self.sels), len(blocks))
+        R = np.zeros((len(self.rels), len(blocks)), bool)
+        X = np.zeros_like(R)
+        for j, (r, p) in enumerate(self.rels):
+            node = NODES["relation"][r]
+            ref = node.refers(p)
+            if ref is not None and ref not in objects:
+                continue
+            for k, b in enumerate(blocks):
+                if b == ref:
+                    X[j, k] = True
+                elif node.ok(f, b, p):  # type: ignore[attr-defined]
+                    R[j, k] = True
+        Si = S.astype(np.int32)
+        C = Si @ R.T.astype(np.int32)
+        size = Si.sum(1)[:, None] - Si @ X.T.astype(np.int32)
+        got = f.memo[key] = (S, R, X, C, size)
+        return got
+
+    def clause_eval(self, f: Facts) -> tuple[np.ndarray, np.ndarray]:
+        """(holds, score) per clause, with a final sentinel (True, 0)."""
+        key = self._tag + ("c",)
+        got = f.memo.get(key)
+        if got is not None:
+            return got
+        n = len(self.clauses)
+        holds = np.ones(n + 1, bool)
+        score = np.zeros(n + 1)
+        if self.each:
+            _, _, _, C, size = self._matrices(f)
+            cnt = C[self.e_sel, self.e_rel]
+            sz = size[self.e_sel, self.e_rel]
+            q, m = self.e_q, self.e_n
+            h = np.where(q == 0, cnt == sz, np.where(q == 1, cnt == 0, np.where(q == 2, cnt == m, cnt >= m)))
+            szc = np.maximum(sz, 1)
+            s = np.where(q == 0, cnt / szc, np.where(q == 1, 1 - cnt / szc, np.where(
+                q == 2, np.clip(1 - np.abs(cnt - m) / np.maximum(szc, m), 0, 1), np.minimum(cnt, m) / np.maximum(m, 1))))
+            holds[self.each] = h
+            score[self.each] = s
+        for i in self.forms:
+            c = self.clauses[i]
+            holds[i] = c.holds(f)
+            score[i] = c.score(f)
+        got = f.memo[key] = (holds, score)
+        return got
+
+    def eval(self, f: Facts) -> tuple[np.ndarray, np.ndarray]:
+        """(holds, score) per goal."""
+        key = self._tag + ("g",)
+        got = f.memo.get(key)
+        if got is None:
+            h, s = self.clause_eval(f)
+            holds = h[self.E].all(1)
+            score = (s[self.E] * self.valid).sum(1) / self.n_clauses
+            got = f.memo[key] = (holds, score)
+        return got
+
+    def clause_moved(self, fb: Facts, fa: Facts, b: str) -> tuple[np.ndarray, np.ndarray]:
+        """Per clause (with a sentinel False): did moving ``b`` go against it; is ``b`` in its group."""
+        key = self._tag + ("o", b)
+        got = fa.memo.get(key)
+        if got is not None and got[0] is fb:
+            return got[1]
+        n = len(self.clauses)
+        off = np.zeros(n + 1, bool)
+        inside = np.zeros(n + 1, bool)
+        if b in fa.blocks:
+            k = fa.blocks.index(b)
+            if self.each:
+                S, R, X, C, _ = self._matrices(fa)
+                ing = S[self.e_sel, k] & ~X[self.e_rel, k]
+                r = R[self.e_rel, k]
+                cnt = C[self.e_sel, self.e_rel]
+                q = self.e_q
+                off[self.each] = ing & (((q == 0) & ~r) | ((q == 1) & r) | ((q == 2) & r & (cnt > self.e_n)))
+                inside[self.each] = ing
+            for i in self.forms:
+                c = self.clauses[i]
+                g = c.group_f(fa)
+                inside[i] = b in g
+                off[i] = inside[i] and c.moved_off(fb, fa, b)
+        fa.memo[key] = (fb, (off, inside))
+        return off, inside
+
+    def moved_off(self, fb: Facts, fa: Facts, b: str) -> np.ndarray:
+        key = self._tag + ("om", b)
+        got = fa.memo.get(key)
+        if got is not None and got[0] is fb:
+            return got[1]
+        off, inside = self.clause_moved(fb, fa, b)
+        res = off[self.E].any(1) | (self.stays & ~inside[self.E].any(1))
+        fa.memo[key] = (fb, res)
+        return res
+
+    # -- per scene --
+
+    def possible(self, objects: tuple[str, ...]) -> np.ndarray:
+        """Static feasibility per goal in a scene of ``objects`` (cached)."""
+        key = tuple(objects)
+        got = self._possible.get(key)
+        if got is None:
+            c = np.array([cl.possible(key) for cl in self.clauses] + [True], bool)
+            got = self._possible[key] = c[self.E].all(1)
+            if len(self._possible) > 4096:
+                self._possible.clear()
+        return got
+
+
+# ---- probe bank ---------------------------------------------------------------------------
+
+
+def probe_bank(seed: int = 0, n_scenes: int = 40, walks: int = 3, planned: int = 25):
+    """Probe scenes with states and moves: random walks of generic moves from a layout, and
+    the plans (each step) of random clauses that the scene allows."""
+    rng = np.random.default_rng(seed)
+    clauses = all_clauses()
+    scenes, states, moves = [], [], []  # states: (scene idx, Facts); moves: (scene idx, fb, fa, block)
+    for i in range(n_scenes):
+        scene = random_scene(rng)
+        scenes.append(tuple(scene.objects))
+        s0 = WorldState(positions=layout(scene, seed * 1000 + i))
+        states.append((i, facts(s0)))
+        for _ in range(walks):
+            s = s0
+            for _ in range(3):
+                options = list(generic_moves(s, facts(s), s.blocks))
+                for j in rng.permutation(len(options))[:10]:
+                    new, fail = apply_skill(s, options[j])
+                    if fail is None:
+                        states.append((i, facts(new)))
+                        moves.append((i, facts(s), facts(new), options[j].block))
+                        s = new
+                        break
+        done = 0
+        for j in rng.permutation(len(clauses)):
+            if done >= planned:
+                break
+            goal = Goal((clauses[j],))
+            if not goal.possible(scenes[-1]):
+                continue
+            p = plan(goal, s0)
+            if not p:
+                continue
+            done += 1
+            s = s0
+            for step in p:
+                new, _ = apply_skill(s, step)
+                states.append((i, facts(new)))
+                moves.append((i, facts(s), facts(new), step.block))
+                s = new
+    return scenes, states, moves
+
+
+# ---- enumeration and de-duplication --------------------------------------------------------
+
+
+def _sources() -> list[Path]:
+    pkg = Path(__file__).resolve().parents[2]
+    lang = sorted((pkg / "learners" / "lang").glob("*.py"))
+    bayes = [pkg / "learners" / "bayes" / n for n in ("facts.py", "planning.py", "hypotheses.py")]
+    return lang + bayes + sorted((pkg / "world").glob("*.py"))
+
+
+def cache_path(tag: str) -> Path:
+    digest = hashlib.sha256(f"numpy {np.__version__} {tag}".encode())
+    for path in _sources():
+        digest.update(f"\0{path.name}\0".encode())
+        digest.update(path.read_bytes())
+    for kind, nodes in NODES.items():  # node types registered at run time (plug-ins) count too
+        for key, node in nodes.items():
+            digest.update(f"\0{kind}:{key}:{type(node).__module__}.{type(node).__qualname__}:{node.params}".encode())
+    root = Path(os.environ.get("ACTIVEINTENT_CACHE", Path.home() / ".cache" / "activeintent"))
+    return root / f"lang-space-{digest.hexdigest()[:16]}-{tag}.json"
+
+
+def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scenes: int = 40) -> dict:
+    """Enumerate, de-duplicate, keep the ``keep`` shortest; returns keys and counts."""
+    t0 = time.time()
+    scenes, states, moves = probe_bank(seed, n_scenes)
+    clauses = sorted(all_clauses(), key=lambda c: (c.bits, c.key))
+    comp = Compiled([Goal((c,)) for c in clauses])
+    n = len(clauses)
+    P = np.array([comp.possible(objs)[:n] for objs in scenes]).T  # [clause, scene]
+    H = np.zeros((n, len(states)), bool)
+    for k, (si, f) in enumerate(states):
+        H[:, k] = comp.clause_eval(f)[0][:n] & P[:, si]
+    Off = np.zeros((n, len(moves)), bool)
+    In = np.zeros((n, len(moves)), bool)
+    for k, (si, fb, fa, b) in enumerate(moves):
+        off, inside = comp.clause_moved(fb, fa, b)
+        Off[:, k] = off[:n] & P[:, si]
+        In[:, k] = inside[:n] & P[:, si]
+    state_scene = np.array([si for si, _ in states])
+    move_scene = np.array([si for si, *_ in moves])
+    generated = 0
+    best: dict[bytes, tuple[float, str]] = {}
+
+    def offer(bits: np.ndarray, keys: list[str], p, h, o) -> None:
+        sig = np.packbits(np.concatenate([p, h, o], axis=1), axis=1)
+        for i in range(len(keys)):
+            if not h[i].any():  # holds nowhere on the bank: nothing could confirm it
+                continue
+            k = sig[i].tobytes()
+            cur = best.get(k)
+            if cur is None or bits[i] < cur[0]:
+                best[k] = (float(bits[i]), keys[i])
+
+    single_bits = np.array([Goal((c,)).bits for c in clauses])
+    for stays in (False, True):
+        o = Off | (stays & ~In & P[:, move_scene])
+        goals = [Goal((c,), stays) for c in clauses]
+        offer(single_bits + 0, [g.key for g in goals], P, H, o)
+        generated += len(goals)
+    # pairs of the simplest behaviourally distinct clauses
+    reps: dict[bytes, int] = {}
+    for i in range(n):
+        if clauses[i].bits <= pair_bits and H[i].any():
+            reps.setdefault(np.packbits(np.concatenate([P[i], H[i], Off[i]])).tobytes(), i)
+    idx = sorted(reps.values())
+    for a_pos, a in enumerate(idx):
+        bs = np.array(idx[a_pos + 1:], int)
+        if not len(bs):
+            continue
+        p = P[a] & P[bs]
+        h = H[a] & H[bs]
+        o = (Off[a] | Off[bs]) & p[:, move_scene]
+        keys = [Goal((clauses[a], clauses[b])).key for b in bs]
+        bits = np.array([Goal((clauses[a], clauses[b])).bits for b in bs])
+        offer(bits, keys, p, h, o)
+        generated += len(bs)
+    del state_scene
+    distinct = sorted(best.values())
+    kept = [k for _, k in distinct[:keep]]
+    return {"keys": kept, "generated": generated, "clauses": n, "distinct": len(distinct),
+            "pair_clauses": len(idx), "probe_scenes": len(scenes), "probe_states": len(states),
+            "probe_moves": len(moves), "seconds": round(time.time() - t0, 1)}
+
+
+def space_info(seed: int = 0, keep: int = 3000) -> dict:
+    """The built space (from the disk cache when the sources have not changed)."""
+    path = cache_path(f"{seed}-{keep}")
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        pass
+    info = build_space(seed, keep)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(info))
+        os.replace(tmp, path)
+    except OSError:
+        pass
+    return info
+
+
+@lru_cache(maxsize=4)
+def goal_space(seed: int = 0, keep: int = 3000) -> tuple[Goal, ...]:
+    return tuple(parse_goal(k) for k in space_info(seed, keep)["keys"])
+
+
+__all__ = ["QUANTS", "Compiled", "build_space", "goal_space", "kind_of", "probe_bank", "space_info"]

@@ -1,0 +1,150 @@
+"""The goal language (learners/lang): planner soundness, the vectorised judge, the learner."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from activeintent.act.base import make_executor
+from activeintent.envs.symbolic import SymbolicEnv
+from activeintent.episode import Episode, EpisodeConfig
+from activeintent.learners.bayes.facts import facts
+from activeintent.learners.bayes.hypotheses import random_scene
+from activeintent.learners.lang import planner
+from activeintent.learners.lang.expr import NODES, Each, Form, Goal, all_clauses, parse_goal
+from activeintent.learners.lang.hypotheses import GoalIntention, LangSpace
+from activeintent.learners.lang.learner import LangLearner
+from activeintent.learners.lang.space import Compiled
+from activeintent.signals import get_signal
+from activeintent.users.simulated import SimulatedUser, user_profile
+from activeintent.world import WorldState, apply_skill, layout
+
+CLAUSES = all_clauses()
+
+
+def random_goal(rng: np.random.Generator) -> Goal:
+    n = 1 + int(rng.random() < 0.3)
+    picked = [CLAUSES[int(i)] for i in rng.choice(len(CLAUSES), size=n, replace=False)]
+    return Goal(tuple(picked), bool(rng.random() < 0.3))
+
+
+def feasible_pairs(rng, n):
+    """``n`` (goal, scene, state) with the goal statically possible in the scene."""
+    out = []
+    while len(out) < n:
+        goal, scene = random_goal(rng), random_scene(rng)
+        if goal.possible(scene.objects):
+            out.append((goal, scene, WorldState(positions=layout(scene, int(rng.integers(1 << 30))))))
+    return out
+
+
+def test_language_size_and_bits():
+    assert len(CLAUSES) > 10_000
+    bits = [c.bits for c in CLAUSES]
+    assert min(bits) > 0
+    # the prior is a uniform choice at each node: description lengths follow the node counts
+    every_block_in_own_bowl = Each("every", "all", "", "in-bowl", "same")
+    n_sel, n_rel = len(NODES["selector"]), len(NODES["relation"])
+    assert every_block_in_own_bowl.bits == pytest.approx(1 + np.log2(6) + np.log2(n_sel) + np.log2(n_rel) + np.log2(3))
+    for c in CLAUSES[::97]:
+        assert parse_goal(Goal((c,), True).key) == Goal((c,), True)
+
+
+def test_planner_satisfies_every_goal_it_claims_feasible():
+    rng = np.random.default_rng(7)
+    planned = 0
+    for goal, _, state in feasible_pairs(rng, 150):
+        p = planner.plan(goal, state)
+        if p is None:
+            continue
+        planned += 1
+        end = planner.run(state, p)
+        assert end is not None, goal.key
+        assert goal.holds(facts(end)), (goal.key, p)
+        if goal.stays:  # blocks outside the goal's groups never move
+            outside = set(state.blocks) - goal.groups(facts(state))
+            assert all(state.positions[b] == end.positions[b] for b in outside)
+    assert planned >= 100
+
+
+def test_compiled_judge_matches_the_goals():
+    rng = np.random.default_rng(3)
+    goals = [random_goal(rng) for _ in range(300)] + [Goal((Form("row", "rainbow", "all", ""),))]
+    comp = Compiled(goals)
+    for _goal, _scene, state in feasible_pairs(rng, 6):
+        f0 = facts(state)
+        for step in planner.generic_moves(state, f0, state.blocks):
+            new, fail = apply_skill(state, step)
+            if fail is None and rng.random() < 0.05:
+                fa = facts(new)
+                holds, score = comp.eval(fa)
+                off = comp.moved_off(f0, fa, step.block)
+                for i, g in enumerate(goals):
+                    assert holds[i] == g.holds(fa), g.key
+                    assert score[i] == pytest.approx(g.score(fa)), g.key
+                    assert off[i] == g.moved_off(f0, fa, step.block), g.key
+
+
+def small_space(true: Goal, rng: np.random.Generator, n: int = 150) -> LangSpace:
+    others = {random_goal(rng).key for _ in range(n)}
+    others.discard(true.key)
+    simple = [Goal((c,)) for c in CLAUSES if c.bits < 10.5]
+    goals = list(dict.fromkeys([true] + simple + [parse_goal(k) for k in sorted(others)]))
+    return LangSpace(goals)
+
+
+def interesting_goal(rng):
+    """A random goal that is feasible in some scene and not already true in its layout."""
+    simple = [c for c in CLAUSES if c.bits < 13]
+    while True:
+        goal = Goal((simple[int(rng.integers(len(simple)))],), bool(rng.random() < 0.3))
+        intention = GoalIntention(goal)
+        try:
+            scene = intention.sample_scene(np.random.default_rng(0))
+        except ValueError:
+            continue
+        if not goal.holds(facts(WorldState(positions=layout(scene, 0)))):
+            return goal
+
+
+@pytest.mark.parametrize("seed,signal", [(1, "stop"), (2, "stop"), (3, "preference")])
+def test_posterior_concentrates_on_a_random_true_goal(seed, signal):
+    rng = np.random.default_rng(seed)
+    true = interesting_goal(rng)
+    space = small_space(true, rng)
+    learner = LangLearner(signal, rng=seed, hypotheses=space.hypotheses)
+    intention = GoalIntention(true)
+    user = SimulatedUser(intention, signal, user_profile("exact"), rng=seed)
+    Episode(learner, intention, user, make_executor("plan"), SymbolicEnv(),
+            EpisodeConfig(budget=10, seed=seed, test_scenes=3, curve=False)).run()
+    w = learner.weights
+    names = [h.name for h in learner.hyps]
+    i = names.index(true.key)
+    prior = np.exp(-np.array([h.bits for h in learner.hyps]) * np.log(2))
+    prior /= prior.sum()
+    assert w[i] > 5 * prior[i], (true.key, learner.top(3))
+    # goals that agree with the truth on everything shown may share its mass; the truth is near the top
+    assert (w > w[i] + 1e-9).sum() < 10, (true.key, learner.top(5))
+
+
+def test_a_wrong_answer_does_not_zero_the_true_goal():
+    rng = np.random.default_rng(5)
+    true = interesting_goal(rng)
+    space = small_space(true, rng)
+    learner = LangLearner("stop", rng=0, hypotheses=space.hypotheses)
+    i = [h.name for h in learner.hyps].index(true.key)
+    scene = GoalIntention(true).sample_scene(np.random.default_rng(0))
+    state = WorldState(positions=layout(scene, 0))
+    steps = planner.plan(true, state)
+    from activeintent.envs.symbolic import symbolic_trajectory
+    from activeintent.learners.base import Estimate, RoundRecord
+
+    traj = symbolic_trajectory(scene, state, steps)
+    sig = get_signal("stop")
+    wrong = sig.parse({"stop_time": 0.2})  # the person stops a plan that achieves their goal
+    record = RoundRecord(index=0, scene=scene, answer=wrong, plans=[steps],
+                         estimate=Estimate(z="", goals=[], plans=[steps]))
+    learner.observe(record, [traj])
+    assert learner.weights[i] > 0
+    assert np.isfinite(learner.belief.log_w[i])
+    assert learner.belief.log_w[i] > -30
