@@ -119,6 +119,14 @@ CORPUS: list[Hostile] = [
     _h("np-astype-variable", "t = 'O'\na = np.zeros(2).astype(t)", REFUSED),
     _h("np-mixed-object", "a = np.array([1, 'a', None])\nsay(a)", CONTAINED),
     _h("np-structured", "a = np.zeros(2, [('f', 'O')])\nsay(a)", CONTAINED),
+    # The real numpy, reached by import when the guard is off: raw memory in the child only.
+    _h("real-numpy-as-strided", "import numpy\na = numpy.lib.stride_tricks.as_strided(numpy.zeros(1), shape=(1 << 26,), "
+       "strides=(64,))\nsay(float(a.sum()))", REFUSED),
+    _h("real-numpy-stride-setter", "import numpy\na = numpy.zeros(2)\na.strides = (1 << 40,)\nsay(a[1])", REFUSED),
+    _h("real-numpy-object-view", "import numpy\nb = numpy.array([0x41414141], dtype=numpy.int64)\n"
+       "o = numpy.ndarray((1,), dtype=object, buffer=b)\nsay(o[0])", REFUSED),
+    _h("real-numpy-frombuffer-write", "import numpy\nb = bytearray(8)\na = numpy.frombuffer(b, dtype=numpy.int64)\n"
+       "a.setflags(write=True)\na[0] = 1\nsay(b)", REFUSED),
     _h("numpy-ctypeslib", "np.ctypeslib.load_library('libc', '/lib')", REFUSED),
     _h("numpy-load", "say(np.load('/etc/passwd'))", REFUSED),
     _h("numpy-tofile", "np.array([1.0]).tofile('CANARY')", REFUSED),

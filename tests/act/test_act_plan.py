@@ -6,6 +6,7 @@ import json
 
 import pytest
 import typer
+from act_helpers import require_namespaces
 from pydantic import ValidationError
 from typer.testing import CliRunner
 
@@ -73,7 +74,8 @@ def test_empty_plan_is_a_failure(state):
     assert result.failure is not None and result.failure.stage == "plan"
 
 
-def test_make_executor_names():
+def test_make_executor_names(monkeypatch):
+    monkeypatch.setenv("ACTIVEINTENT_UNSAFE_NO_ISOLATION", "1")  # `cap` with a model checks isolation
     assert make_executor("parse").name == "parse"
     assert make_executor("PLAN", ScriptedModel([])).name == "plan"
     assert make_executor("cap", ScriptedModel([])).name == "cap"
@@ -96,6 +98,7 @@ def test_feedback_text():
 
 
 def test_act_bench_json():
+    require_namespaces()
     app = typer.Typer()
 
     @app.callback()

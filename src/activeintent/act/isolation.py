@@ -103,6 +103,16 @@ def _root_tools() -> tuple[str, str, str] | None:
     return tools if all(tools) else None  # type: ignore[return-value]
 
 
+def _stage_dir(paths: list[str]) -> str | None:
+    """An existing folder to cover with the staging tmpfs: one that holds none of ``paths``."""
+    for candidate in ("/mnt", "/media", "/srv", "/opt", "/tmp", "/var/tmp", "/run"):
+        if os.path.isdir(candidate) and not os.path.islink(candidate) and not any(
+            p == candidate or p.startswith(candidate + "/") for p in paths
+        ):
+            return candidate
+    return None
+
+
 def bwrap_command(bwrap: str, argv: list[str], package_root: str, drop_root: bool = False) -> list[str]:
     """The command line that runs ``argv`` isolated (see the module docstring).
 
@@ -115,8 +125,9 @@ def bwrap_command(bwrap: str, argv: list[str], package_root: str, drop_root: boo
     paths = [p for p in readonly_paths(package_root) if not (p == "/usr" or p.startswith("/usr/"))]
     sources = {p: p for p in paths}
     tools = _root_tools() if drop_root else None
-    if tools is not None:
-        sources = {p: f"/tmp/{i}" for i, p in enumerate(paths)}
+    stage = _stage_dir(paths) if tools is not None else None
+    if stage is not None:
+        sources = {p: f"{stage}/{i}" for i, p in enumerate(paths)}
     cmd = [
         bwrap,
         "--unshare-user", "--unshare-pid", "--unshare-net", "--unshare-ipc", "--unshare-uts",
@@ -136,11 +147,11 @@ def bwrap_command(bwrap: str, argv: list[str], package_root: str, drop_root: boo
         cmd += ["--ro-bind", sources[path], path]
     cmd += ["--proc", "/proc", "--dev", "/dev", "--remount-ro", "/dev", "--chdir", "/", "--remount-ro", "/"]
     cmd += list(argv)
-    if tools is None:
+    if tools is None or stage is None:
         return cmd
     unshare, mount, setpriv = tools
     q = shlex.quote
-    script = [f"set -e; {q(mount)} -t tmpfs -o mode=0755,size=64k activeintent-stage /tmp"]
+    script = [f"set -e; {q(mount)} -t tmpfs -o mode=0755,size=64k activeintent-stage {q(stage)}"]
     for path in paths:
         script.append(f"mkdir {q(sources[path])}; {q(mount)} --bind {q(path)} {q(sources[path])}")
     script.append(
@@ -168,6 +179,8 @@ def _probe(bwrap: str, package_root: str, python: str, root: bool) -> tuple[bool
     if root:
         if _root_tools() is None:
             note = "unshare, mount or setpriv missing"
+        elif _stage_dir(readonly_paths(package_root)) is None:
+            note = "no folder to stage the read-only paths in"
         elif (problem := _try(bwrap_command(bwrap, check, package_root, drop_root=True))) is None:
             return True, None, None
         else:
