@@ -148,3 +148,13 @@ def test_a_wrong_answer_does_not_zero_the_true_goal():
     assert learner.weights[i] > 0
     assert np.isfinite(learner.belief.log_w[i])
     assert learner.belief.log_w[i] > -30
+
+
+def test_explain_finds_the_goal_of_a_sentence():
+    from activeintent.learners.lang.explain import explain
+
+    got = explain("Stack all the blocks into a single tower.")
+    assert got["expressible"] and got["matches"][0]["key"] == "form tower:any all:"
+    got = explain("Put every block in the bowl of its own colour")
+    assert got["matches"][0]["key"] == "every all: in-bowl:same"
+    assert not explain("Juggle while singing loudly")["expressible"]

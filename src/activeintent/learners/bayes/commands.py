@@ -14,9 +14,21 @@ def register(app: typer.Typer) -> None:
     def hypotheses(
         examples: Annotated[int, typer.Option(min=0, help="how many example hypotheses to list")] = 15,
         as_json: Annotated[bool, typer.Option("--json", help="print JSON instead of a table")] = False,
+        explain: Annotated[str | None, typer.Option(
+            "--explain", help="how a sentence is expressed in the goal language of lang-* (or that it is not)")] = None,
+        language: Annotated[bool, typer.Option(
+            "--language", help="the goal language of lang-*: node types, counts, examples")] = False,
     ) -> None:
         """The Bayesian learners' hypothesis space H: size, prior, examples."""
         import numpy as np
+
+        if explain is not None or language:
+            from activeintent.learners.lang.explain import explain as explain_sentence
+            from activeintent.learners.lang.explain import language_summary
+
+            out = explain_sentence(explain) if explain is not None else language_summary(examples)
+            typer.echo(json.dumps(out, indent=2, ensure_ascii=False) if as_json else _lang_text(out))
+            return
 
         from activeintent.learners.bayes.hypotheses import (
             enumerate_hypotheses,
@@ -83,6 +95,25 @@ def register(app: typer.Typer) -> None:
         from rich.console import Console
 
         Console().print_json(json.dumps(result))
+
+
+def _lang_text(out: dict) -> str:
+    """Plain text of ``hypotheses --explain`` / ``--language``."""
+    lines: list[str] = []
+    if "matches" in out:
+        lines.append(f"{out['sentence']!r}: {out['note']}")
+        for m in out["matches"]:
+            lines.append(f"  {m['score']:.2f}  {m['bits']:6.2f} bits  {m['sentence']}\n{'':21}{m['key']}")
+        return "\n".join(lines)
+    lines += out["grammar"]
+    for kind, nodes in out["nodes"].items():
+        lines.append(f"{kind}s:")
+        lines += [f"  {n['key']:<16} {n['choices']:>3} choices  {n['bits']:5.2f} bits  {', '.join(map(str, n['params']))}"
+                  for n in nodes]
+    lines.append("counts: " + ", ".join(f"{k} {v}" for k, v in out["counts"].items()))
+    lines.append("examples:")
+    lines += [f"  {e['bits']:6.2f} bits  {e['sentence']}" for e in out["examples"]]
+    return "\n".join(lines)
 
 
 class _Keep:

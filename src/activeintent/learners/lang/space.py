@@ -6,7 +6,8 @@ and every unordered pair of the simplest distinct clauses. De-duplication: goals
 a seeded bank of probe scenes — per scene whether the goal can be shown (static check), per
 probe state whether it holds, per probe move whether the move goes against it; goals with the
 same answers everywhere are one (the shortest is kept), goals that hold on no probe state are
-dropped (nothing could confirm them). The ``keep`` shortest distinct goals form the space.
+dropped (nothing could confirm them). The shortest distinct one-clause goals (60 %) and
+two-clause goals (40 %) of ``keep`` form the space.
 The list is cached on disk under ``$ACTIVEINTENT_CACHE`` (default ``~/.cache/activeintent``),
 keyed by a hash of the sources it depends on and of the registered node types.
 """
@@ -29,6 +30,7 @@ from activeintent.learners.lang.planner import generic_moves, plan
 from activeintent.world import WorldState, apply_skill, layout
 from activeintent.world.scene import kind_of
 
+PAIR_SHARE = 0.4  # share of the kept space given to two-clause goals
 Q_CODE = {"every": 0, "none": 1, "exactly": 2, "at-least": 3}
 
 
@@ -242,7 +244,7 @@ def probe_bank(seed: int = 0, n_scenes: int = 40, walks: int = 3, planned: int =
 
 def _sources() -> list[Path]:
     pkg = Path(__file__).resolve().parents[2]
-    lang = sorted((pkg / "learners" / "lang").glob("*.py"))
+    lang = [pkg / "learners" / "lang" / n for n in ("expr.py", "planner.py", "space.py")]
     bayes = [pkg / "learners" / "bayes" / n for n in ("facts.py", "planning.py", "hypotheses.py")]
     return lang + bayes + sorted((pkg / "world").glob("*.py"))
 
@@ -316,7 +318,12 @@ def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scen
         generated += len(bs)
     del state_scene
     distinct = sorted(best.values())
-    kept = [k for _, k in distinct[:keep]]
+    # The truncation keeps the shortest goals of each size (one clause / two clauses), so that
+    # the space is not only one-clause goals; within the space the prior is still 2^-bits.
+    one = [k for _, k in distinct if " & " not in k.replace(" & stays", "")]
+    two = [k for _, k in distinct if " & " in k.replace(" & stays", "")]
+    n_two = int(keep * PAIR_SHARE)
+    kept = one[:keep - min(n_two, len(two))] + two[:n_two]
     return {"keys": kept, "generated": generated, "clauses": n, "distinct": len(distinct),
             "pair_clauses": len(idx), "probe_scenes": len(scenes), "probe_states": len(states),
             "probe_moves": len(moves), "seconds": round(time.time() - t0, 1)}

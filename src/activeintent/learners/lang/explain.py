@@ -1,0 +1,116 @@
+"""From an English sentence to the closest goals of the language (``hypotheses --explain``),
+and a summary of the language (``hypotheses --language``).
+
+The matcher is deliberately simple: words are normalised (plurals, a few synonyms), every
+one-clause goal's sentence is compared with the request by weighted word overlap, and a
+request made of two parts ("…, and …") is also matched as a pair of clauses. A best match
+below ``MIN_SCORE`` means the language has no goal for the sentence.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections import Counter
+from functools import lru_cache
+
+from activeintent.learners.lang.expr import NODES, QUANTS, Goal, all_clauses
+
+MIN_SCORE = 0.45
+STOP = {"the", "a", "an", "is", "are", "be", "should", "to", "of", "on", "in", "and", "it", "its", "their",
+        "all", "please", "put", "place", "each", "every", "go", "table", "them", "they", "with", "by",
+        "want", "i", "that", "so", "into", "one", "let", "make", "sure", "at", "from", "other"}
+SYNONYMS = {
+    "color": "colour", "grey": "gray", "stacked": "tower", "stack": "tower", "pile": "tower",
+    "line": "row", "horizontally": "row", "horizontal": "row", "aligned": "row", "align": "row",
+    "vertically": "column", "vertical": "column", "matching": "own", "match": "own", "same": "own",
+    "different": "another", "mismatch": "another", "mismatched": "another", "warm": "warm",
+    "cold": "cool", "top": "back", "bottom": "front", "far": "back", "near": "front", "center": "centre",
+    "beside": "next", "touching": "touching", "together": "together", "separate": "per", "apart": "per",
+    "rainbow": "rainbow", "stay": "stays", "untouched": "stays", "leave": "stays", "remain": "stays",
+}
+
+
+def words(text: str) -> list[str]:
+    out = []
+    for w in re.findall(r"[a-z]+", text.lower()):
+        w = SYNONYMS.get(w, w)
+        if len(w) > 3 and w.endswith("s") and w not in {"stays", "class", "towers"}:
+            w = w[:-1]
+        w = SYNONYMS.get(w, w)
+        if w not in STOP:
+            out.append(w)
+    return out
+
+
+@lru_cache(maxsize=1)
+def _index() -> tuple[list[Goal], list[Counter], dict[str, float]]:
+    goals = [Goal((c,)) for c in all_clauses()]
+    bags = [Counter(words(re.sub(r"\(.*?\)", "", g.sentence()))) for g in goals]
+    df: Counter = Counter()
+    for b in bags:
+        df.update(set(b))
+    idf = {w: math.log(len(bags) / n) + 1 for w, n in df.items()}
+    return goals, bags, idf
+
+
+def _sim(query: Counter, bag: Counter, idf: dict[str, float]) -> float:
+    """Weighted overlap, symmetric (F1-like) so that both extra and missing words cost."""
+    common = sum(idf.get(w, 3.0) for w in query if w in bag)
+    q = sum(idf.get(w, 3.0) for w in query)
+    b = sum(idf.get(w, 3.0) for w in bag)
+    return 2 * common / (q + b) if q and b else 0.0
+
+
+def _matches(text: str, n: int) -> list[tuple[float, Goal]]:
+    goals, bags, idf = _index()
+    q = Counter(words(text))
+    scored = sorted(((_sim(q, b, idf), -g.bits, i) for i, (g, b) in enumerate(zip(goals, bags, strict=True))),
+                    reverse=True)[:n]
+    return [(s, goals[i]) for s, _, i in scored]
+
+
+def explain(sentence: str, n: int = 5) -> dict:
+    """The closest goals to ``sentence`` (one clause, or two for a two-part request)."""
+    stays = "stays" in words(sentence)
+    core = re.split(r"(?:everything|every other block|the rest|other blocks?)\s+(?:else\s+)?(?:stay|remain)",
+                    sentence, flags=re.I)[0]
+    found = [(s, Goal(g.clauses, stays)) for s, g in _matches(core, n)]
+    parts = [p for p in re.split(r",?\s+and\s+|;\s*|,\s+while\s+|,\s+but\s+", core) if len(words(p)) >= 2]
+    if len(parts) == 2:
+        a, b = _matches(parts[0], 3), _matches(parts[1], 3)
+        for sa, ga in a:
+            for sb, gb in b:
+                if ga.key != gb.key:
+                    found.append(((sa + sb) / 2, Goal(ga.clauses + gb.clauses, stays)))
+    found.sort(key=lambda x: (-x[0], x[1].bits))
+    rows = [{"score": round(s, 3), "key": g.key, "bits": round(g.bits, 2), "sentence": g.sentence()}
+            for s, g in found[:n]]
+    ok = bool(rows) and rows[0]["score"] >= MIN_SCORE
+    return {"sentence": sentence, "expressible": ok, "matches": rows,
+            "note": "closest goal of the language" if ok else
+            "no goal of the language matches this sentence well; the closest ones are listed"}
+
+
+def language_summary(examples: int = 12) -> dict:
+    """Node types with their parameters and bits, the counts of the space, examples."""
+    from activeintent.learners.lang.learner import KEEP
+    from activeintent.learners.lang.space import goal_space, space_info
+
+    kinds = {}
+    for kind, nodes in NODES.items():
+        kinds[kind] = [{"key": k, "choices": len(node.params), "bits": round(node.bits(), 2),
+                        "params": list(node.params[:6]) + (["…"] if len(node.params) > 6 else [])}
+                       for k, node in nodes.items()]
+    info = space_info(0, KEEP)
+    goals = goal_space(0, KEEP)
+    step = max(1, len(goals) // max(examples, 1))
+    return {
+        "grammar": ["goal → clause [& clause] [& every other block stays]",
+                    "clause → quantifier selector relation | structure selector",
+                    f"quantifier → {' | '.join(QUANTS)}",
+                    "bits = Σ over nodes log2(choices); prior P(z) ∝ 2^-bits"],
+        "nodes": kinds,
+        "counts": {k: v for k, v in info.items() if k != "keys"} | {"kept": len(info["keys"])},
+        "examples": [{"key": g.key, "bits": round(g.bits, 2), "sentence": g.sentence()} for g in goals[::step]],
+    }
