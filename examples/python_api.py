@@ -1,23 +1,41 @@
-"""Run one episode from Python: a simulated user, a learner, an executor and the simulator.
+"""Run one episode from Python: a simulated user, a learner, an executor and an env.
 
-    .venv/bin/python examples/python_api.py
+    .venv/bin/python examples/python_api.py            # bayes-stop, no model, symbolic env
+    .venv/bin/python examples/python_api.py mllm-llm   # the paper's best method on the embedded model
 """
 
-from activeintent.act.base import make_executor
-from activeintent.episode import Episode, EpisodeConfig, EpisodeSeeds
-from activeintent.intentions.registry import get_intention
-from activeintent.learners.registry import make_learner
-from activeintent.llm.registry import load_model
-from activeintent.sim.env import TabletopEnv
-from activeintent.users.simulated import UserConfig, make_user
+import sys
 
+from activeintent.act.base import make_executor
+from activeintent.envs import make_env
+from activeintent.episode import Episode, EpisodeConfig, EpisodeSeeds
+from activeintent.learners.registry import LearnerContext, get_method
+from activeintent.suites import resolve
+from activeintent.users.simulated import SimulatedUser, user_profile
+
+method = get_method(sys.argv[1] if len(sys.argv) > 1 else "bayes-stop")
 seeds = EpisodeSeeds.from_seed(7)
-intention = get_intention("stack")  # hidden from the learner; only the user knows it
-user = make_user("stop", intention, UserConfig(), seed=seeds.user)
-llm = load_model("embedded")  # or "openai:gpt-4o" with OPENAI_API_KEY set
-learner = make_learner("mllm-llm", llm=llm, retriever="symbolic", seed=seeds.learner)
-with TabletopEnv() as env:
-    episode = Episode(learner, intention, user, make_executor("plan", model=llm), env,
-                      EpisodeConfig(rounds=3, seed=7), out_dir="runs/example")
-    result = episode.run()
-print(f"success={result.success} z={result.final_preference!r} signals={result.signals_used}")
+intention = resolve("stack")  # hidden from the learner; only the user holds it
+user = SimulatedUser(intention, method.signal, user_profile("human"), rng=seeds.user)
+llm = None
+if method.needs_llm:
+    from activeintent.llm.registry import load_model
+
+    llm = load_model("embedded")  # or "openai:gpt-4o" with OPENAI_API_KEY set
+learner = method(LearnerContext(llm=llm, seed=seeds.learner))
+
+
+def usage():  # the episode reports the model calls it caused
+    if llm is None:
+        return 0, 0, 0
+    t = llm.usage.snapshot()
+    return t.calls, t.prompt_tokens, t.completion_tokens
+
+
+env = make_env("symbolic")  # or "pybullet" for physics and videos
+episode = Episode(learner, intention, user, make_executor("plan", model=llm), env,
+                  EpisodeConfig(budget=3, seed=7), out_dir="runs/example", usage=usage)
+result = episode.run()
+env.close()
+print(f"success@3={result.success} success_at={result.success_at} z={result.final_z!r} "
+      f"signals={result.signals_used} model calls={result.llm_calls}")

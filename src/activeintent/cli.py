@@ -19,6 +19,7 @@ _COMMAND_MODULES = (
     "activeintent.commands",
     "activeintent.act.commands",
     "activeintent.bench.commands",
+    "activeintent.bench.perf",
     "activeintent.intentions.commands",
     "activeintent.learners.bayes.commands",
     "activeintent.llm.commands",

@@ -11,7 +11,8 @@ executor, the env and the user.
         success_at[k] = score(learner's current answer on the test scenes)
 
 Observers subscribe to events: ``started``, ``shown`` (a query's τ are ready), ``answered``
-(a round's record), ``scored`` (success after signal k) and ``finished``. The live table,
+(a round's record), ``tested`` (a test scene run in physics), ``scored`` (success after
+signal k) and ``finished``. The live table,
 the web session and the records writer are observers.
 """
 
@@ -271,6 +272,7 @@ class Episode:
                 traj = self.clock.timed("env_s", self.env.execute, plan)
                 log.success_physics = bool(self.clock.timed("scoring_s", self.intention.satisfied, traj.outcome))
                 log.failure = log.failure or ("; ".join(s.reason or "" for s in traj.failures) or None)
+                self.emit("tested", k, i, scene, est, traj)
                 if i == 0 and self.config.video != "none":
                     self._video(traj, "final")
             logs.append(log)

@@ -50,5 +50,3 @@ def run_options(**values) -> RunOptions:
             name = "--" + str(e["loc"][0]).replace("_", "-")
             msgs.append(f"{name}: {e['msg']} (got {e.get('input')!r})")
         raise ValueError("; ".join(msgs)) from None
-
-Rounds = Budget  # `serve --rounds`: signals asked of each participant (the budget K)

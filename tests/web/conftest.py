@@ -14,7 +14,7 @@ import httpx
 import pytest
 import uvicorn
 
-from activeintent.learners.registry import SIGNAL
+from activeintent.learners.registry import get_method
 from activeintent.web.limits import Limits, SessionLimits
 from activeintent.web.server import create_app, runner_builder
 from activeintent.web.session import SessionManager, StudyConfig
@@ -76,10 +76,10 @@ def live_server(tmp_path) -> Iterator:
 
     def start(method: str, rounds: int = 2, limits: Limits | dict | None = None, clock=None, **study) -> LiveServer:
         out = tmp_path / f"out-{len(servers)}"
-        config = StudyConfig(method=method, signal=SIGNAL[method], rounds=rounds, out_dir=out, **study)
+        config = StudyConfig(method=method, signal=get_method(method).signal, rounds=rounds, out_dir=out, **study)
         if isinstance(limits, dict):
             limits = Limits(**limits)
-        app = create_app(config, runner_builder(config, llm="none"),  # Bayesian methods, no model
+        app = create_app(config, runner_builder(config, llm="none", test_scenes=2),  # Bayesian methods, no model
                          limits=limits, clock=clock or time.monotonic)
         port = _free_port()
         server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))

@@ -3,23 +3,23 @@ mapping of a stop in the video to the trajectory (the same h a simulated stop us
 
 from __future__ import annotations
 
-import math
 import threading
 
 import numpy as np
 import pytest
 
-from activeintent.signals import PreferenceFeedback, StopFeedback
-from activeintent.sim.trajectory import StepRecord, Trajectory
+from activeintent.signals.preference import PreferenceAnswer
+from activeintent.signals.stop import StopAnswer
 from activeintent.users.human import (
     AnswerRejected,
     HumanUser,
     SessionCancelled,
-    stop_feedback,
+    stop_answer,
     video_duration,
     video_frames,
 )
 from activeintent.world import PutIn, Scene, WorldState
+from activeintent.world.trajectory import StepRecord, Trajectory
 
 
 def _trajectory(n_ticks: int = 181, dt: float = 1 / 60) -> Trajectory:
@@ -58,20 +58,19 @@ def test_video_length_matches_frames_of_the_trajectory():
     assert video_frames(odd, 10) == 31 and video_duration(odd, 10) == pytest.approx(3.1)
 
 
-@pytest.mark.parametrize("t", [0.0, 0.05, 0.1, 0.35, 1.234, 1.6, 2.999, 3.0])
-def test_stop_maps_media_time_to_tick_frame_and_step(t):
-    traj = _trajectory()
-    h = stop_feedback(traj, t, fps=10)
+@pytest.mark.parametrize("t,tick,frame", [(0.0, 0, 0), (0.05, 3, 0), (0.1, 6, 1), (0.35, 21, 3),
+                                          (1.234, 74, 12), (1.6, 96, 16), (2.999, 180, 29), (3.0, 180, 30)])
+def test_stop_maps_media_time_to_tick_and_frame(t, tick, frame):
+    h = stop_answer(_trajectory(), t, fps=10)
     assert h.stop_time == pytest.approx(t)
-    assert h.tick == round(t * 60)
-    assert h.frame == math.floor(t * 10 + 1e-9)
-    assert h.step_index == traj.step_at(t)
+    assert (h.tick, h.frame) == (tick, frame)
     assert h.stopped and not h.new_scene
+    assert "step_index" not in h.model_dump()  # a person's stop is a time, not a step
 
 
 def test_stop_on_the_last_frame_after_the_end_is_clipped_to_the_trajectory():
     traj = _trajectory()
-    h = stop_feedback(traj, 3.07, fps=10)  # the last frame stays on screen until 3.1 s
+    h = stop_answer(traj, 3.07, fps=10)  # the last frame stays on screen until 3.1 s
     assert h.stop_time == pytest.approx(3.0)
     assert h.tick == traj.n_ticks - 1
     assert h.frame == 30
@@ -80,7 +79,7 @@ def test_stop_on_the_last_frame_after_the_end_is_clipped_to_the_trajectory():
 @pytest.mark.parametrize("t", [-0.01, 3.2, float("nan"), float("inf"), -float("inf")])
 def test_stop_outside_the_video_is_rejected(t):
     with pytest.raises(AnswerRejected, match="outside the video") as err:
-        stop_feedback(_trajectory(), t, fps=10)
+        stop_answer(_trajectory(), t, fps=10)
     assert err.value.status == 422
 
 
@@ -104,7 +103,7 @@ def test_preference_answer_is_handed_to_the_episode():
     thread, out = _respond_in_thread(user, [_trajectory(), _trajectory()])
     q = user.wait_question(10)
     assert q is not None and q.round == 1 and q.presented == "videos" and presented == [1]
-    h = user.answer(1, lambda q: PreferenceFeedback(choice="A"))
+    h = user.answer(1, lambda q: PreferenceAnswer(choice="A"))
     thread.join(10)
     assert out == {"h": h} and h.choice == "A"
     assert user.question is None
@@ -113,24 +112,24 @@ def test_preference_answer_is_handed_to_the_episode():
 def test_answers_for_other_rounds_or_no_round_are_rejected_and_change_nothing():
     user = HumanUser("stop", timeout=30)
     with pytest.raises(AnswerRejected, match="no question is waiting") as err:
-        user.answer(1, lambda q: StopFeedback())
+        user.answer(1, lambda q: StopAnswer())
     assert err.value.status == 409
     thread, out = _respond_in_thread(user, [_trajectory()])
     assert user.wait_question(10).round == 1
     for wrong in (0, 2, 7):
         with pytest.raises(AnswerRejected, match="waiting for round 1"):
-            user.answer(wrong, lambda q: StopFeedback())
+            user.answer(wrong, lambda q: StopAnswer())
     with pytest.raises(AnswerRejected, match="outside the video"):
-        user.answer(1, lambda q: stop_feedback(q.trajectories[0], 99.0, 10))
+        user.answer(1, lambda q: stop_answer(q.trajectories[0], 99.0, 10))
     with pytest.raises(AnswerRejected, match="asks for stop answers"):
-        user.answer(1, lambda q: PreferenceFeedback(choice="A"))
+        user.answer(1, lambda q: PreferenceAnswer(choice="A"))
     assert user.question is not None and "h" not in out  # still waiting for a valid answer
-    user.answer(1, lambda q: stop_feedback(q.trajectories[0], 1.5, 10))
+    user.answer(1, lambda q: stop_answer(q.trajectories[0], 1.5, 10))
     thread.join(10)
     assert out["h"].tick == 90
     # the same round again (a replayed answer) is refused
     with pytest.raises(AnswerRejected, match="no question is waiting"):
-        user.answer(1, lambda q: StopFeedback())
+        user.answer(1, lambda q: StopAnswer())
 
 
 def test_timeout_and_cancel_end_the_wait():
@@ -138,7 +137,7 @@ def test_timeout_and_cancel_end_the_wait():
     with pytest.raises(SessionCancelled, match="no answer within"):
         user.respond(SCENE, [_trajectory()])
     with pytest.raises(AnswerRejected, match="has ended"):
-        user.answer(1, lambda q: StopFeedback())
+        user.answer(1, lambda q: StopAnswer())
 
     user = HumanUser("preference", timeout=None)
     thread, out = _respond_in_thread(user, [_trajectory(), _trajectory()])

@@ -31,7 +31,7 @@ def test_serve_binds_loopback_and_answers(tmp_path):
     out = tmp_path / "study"
     proc = subprocess.Popen(
         [sys.executable, "-m", "activeintent.cli", "serve", "--port", str(port), "--method", "bayes-stop",
-         "--rounds", "3", "--hide-estimate", "--out", str(out)],
+         "--budget", "3", "--hide-estimate", "--out", str(out)],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )
     try:

@@ -13,7 +13,7 @@ import httpx
 import pytest
 from imageio_ffmpeg import count_frames_and_secs
 
-from activeintent.episode import read_rounds
+from activeintent.records import read_rounds
 
 pytestmark = pytest.mark.slow  # real episodes: simulator, video export
 
@@ -94,9 +94,9 @@ def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server)
     assert snapshot(folder) == before, "a rejected answer changed the saved data"
 
     ok = httpx.post(answer, json={"kind": "preference", "round": 1, "choice": "B", "client_ts": 1.0})
-    assert ok.status_code == 200 and ok.json()["feedback"]["choice"] == "B"
+    assert ok.status_code == 200 and ok.json()["answer"]["choice"] == "B"
     rounds = wait_for(lambda: read_rounds(folder / "rounds.jsonl"), what="rounds.jsonl")
-    assert rounds[0]["feedback"] == {"kind": "preference", "choice": "B"}
+    assert rounds[0]["answer"] == {"signal": "preference", "new_scene": False, "choice": "B"}
 
     # the same answer again (a replay) is refused and the log keeps one round
     after = snapshot(folder)
@@ -147,17 +147,17 @@ def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server):
     t = 0.45  # media time → trajectory time 0.45 s: frame 4, tick round(0.45 / dt)
     res = httpx.post(answer, json={"kind": "stop", "round": 1, "action": "stop", "time": t})
     assert res.status_code == 200, res.text
-    h = res.json()["feedback"]
+    h = res.json()["answer"]
     assert h["stop_time"] == pytest.approx(t) and h["frame"] == 4
     session = srv.manager.get(sid)
     assert session.join(300), "the episode did not finish"
     assert session.status == "finished", session.error
     rounds = read_rounds(folder / "rounds.jsonl")
-    assert len(rounds) == 1 and rounds[0]["feedback"] == h
+    assert len(rounds) == 1 and rounds[0]["answer"] == h
     summary = json.loads((folder / "summary.json").read_text())
     assert summary["method"] == "bayes-stop" and summary["signals_used"] == 1
     assert httpx.get(f"{api}/sessions/{sid}/result").json() == summary
-    assert (folder / "final.webm").stat().st_size > 0 and (folder / "round1_y.gif").exists()
+    assert (folder / "final.webm").stat().st_size > 0 and (folder / "round1_y.webm").exists()
 
     # a finished session takes no answers; its saved data stays as it is
     done = snapshot(folder)

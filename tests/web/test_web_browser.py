@@ -16,7 +16,7 @@ from urllib.parse import parse_qs, urlsplit
 
 import pytest
 
-from activeintent.episode import read_rounds
+from activeintent.records import read_rounds
 from activeintent.sim.env import SimConfig
 
 DOCS_IMG = Path(__file__).resolve().parents[2] / "docs" / "img"
@@ -92,14 +92,14 @@ def test_two_round_preference_session(live_server, page, tmp_path):
     assert session.join(120) and session.status == "finished", session.error
     folder = srv.session_dir(sid)
     rounds = read_rounds(folder / "rounds.jsonl")
-    assert [r["feedback"] for r in rounds] == [
-        {"kind": "preference", "choice": "A"},
-        {"kind": "preference", "choice": "cant_choose"},
+    assert [r["answer"] for r in rounds] == [
+        {"signal": "preference", "new_scene": False, "choice": "A"},
+        {"signal": "preference", "new_scene": False, "choice": "cant_choose"},
     ]
     summary = json.loads((folder / "summary.json").read_text())
     assert summary["method"] == "bayes-preference" and summary["signals_used"] == 2
     for name in ("round1_a", "round1_b", "round2_a", "round2_b"):
-        assert (folder / f"{name}.webm").stat().st_size > 0 and (folder / f"{name}.gif").exists()
+        assert (folder / f"{name}.webm").stat().st_size > 0
     assert (folder / "final.webm").exists()
     log = events(folder)
     choices = [(e["round"], e["data"]["choice"]) for e in log if e["type"] == "choice"]
@@ -152,18 +152,17 @@ def test_clicker_session_stops_at_a_known_moment(live_server, page, tmp_path):
     assert session.join(120) and session.status == "finished", session.error
     rounds = read_rounds(folder / "rounds.jsonl")
     assert len(rounds) == 2
-    h1, h2 = rounds[0]["feedback"], rounds[1]["feedback"]
+    h1, h2 = rounds[0]["answer"], rounds[1]["answer"]
     log_hz = SimConfig().log_hz
-    assert h1["kind"] == "stop" and not h1["new_scene"]
+    assert h1["signal"] == "stop" and not h1["new_scene"]
     assert h1["stop_time"] == pytest.approx(target, abs=1e-3)
     assert h1["frame"] == k == math.floor(h1["stop_time"] * fps)
     # within one video frame of the intended tick
     assert abs(h1["tick"] - round(target * log_hz)) <= log_hz / fps
-    assert h2 == {"kind": "stop", "stop_time": None, "tick": None, "frame": None,
-                  "step_index": None, "new_scene": False}
+    assert h2 == {"signal": "stop", "stop_time": None, "tick": None, "frame": None, "new_scene": False}
     log = events(folder)
     stops = [e for e in log if e["type"] == "stop"]
     assert len(stops) == 1 and stops[0]["data"]["via"] == "key" and stops[0]["round"] == 1
     assert [e["data"]["via"] for e in log if e["type"] == "looks_good"] == ["click"]
     answers = [e for e in log if e["type"] == "answer" and e["source"] == "server"]
-    assert [a["feedback"] for a in answers] == [h1, h2]
+    assert [a["answer"] for a in answers] == [h1, h2]

@@ -23,8 +23,9 @@ from fastapi.responses import FileResponse
 from fastapi.staticfiles import StaticFiles
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from activeintent.signals import PreferenceFeedback, StopFeedback
-from activeintent.users.human import AnswerRejected, Question, stop_feedback
+from activeintent.signals import Answer as SignalAnswer
+from activeintent.signals import get_signal
+from activeintent.users.human import AnswerRejected, Question, stop_answer
 from activeintent.web.errors import ApiError, install_error_handlers
 from activeintent.web.limits import BodyGuard, Limits, SessionLimits, event_lines_size
 from activeintent.web.session import (
@@ -115,18 +116,20 @@ def _feedback_maker(session: WebSession, body: PreferenceAnswer | StopAnswer):
             status=422,
         )
 
-    def make(q: Question) -> PreferenceFeedback | StopFeedback:
+    signal = get_signal(session.config.signal)
+
+    def make(q: Question) -> SignalAnswer:
         if isinstance(body, PreferenceAnswer):
-            return PreferenceFeedback(choice=body.choice)
+            return signal.new_scene() if body.choice == "new_scene" else signal.parse({"choice": body.choice})
         if body.action == "stop":
             if body.time is None:
                 raise AnswerRejected("action 'stop' needs 'time': the video time in seconds", status=422)
-            return stop_feedback(q.trajectories[0], body.time, session.config.fps)
+            return stop_answer(q.trajectories[0], body.time, session.config.fps)
         if body.time is not None:
             raise AnswerRejected(f"action '{body.action}' takes no 'time'", status=422)
         if body.action == "new_scene":
-            return StopFeedback(new_scene=True)
-        return StopFeedback(stop_time=None)
+            return signal.new_scene()
+        return signal.parse({"stop_time": None})
 
     return make
 
@@ -201,7 +204,7 @@ def create_app(
         session = session_or_404(sid)
         client = {"client_ts": body.client_ts, **({"time": body.time} if isinstance(body, StopAnswer) else {})}
         h = session.answer(body.round, _feedback_maker(session, body), client=client)
-        return {"accepted": True, "round": body.round, "feedback": h.model_dump()}
+        return {"accepted": True, "round": body.round, "answer": h.model_dump(mode="json")}
 
     @app.post("/api/sessions/{sid}/events", summary="Append raw UI events (client timestamps kept)")
     def post_events(sid: str, body: EventBatch) -> dict:
@@ -262,13 +265,16 @@ def _page(name: str):
 def runner_builder(config: StudyConfig, **options: Any) -> EpisodeBuilder:
     """Sessions built by :func:`activeintent.runner.build_episode` (method, intention, rounds
     from the study; ``options`` are further RunOptions fields, e.g. llm)."""
-    base = {"method": config.method, "rounds": config.rounds, **options}
+    # People watch physics; the session exports its own videos; the learner is scored on the
+    # test scenes before the first and after the last answer only (no one waits for a curve).
+    base = {"method": config.method, "budget": config.rounds, "env": "pybullet", "video": "none",
+            "curve": False, **options}
     if config.intention is not None:
         base["intention"] = config.intention
 
-    def build(seed: int, out_dir: Path, user, on_round):
+    def build(seed: int, out_dir: Path, user, observers):
         from activeintent.runner import RunOptions, build_episode
 
-        return build_episode(RunOptions(**base, seed=seed), out_dir, user=user, on_round=on_round)
+        return build_episode(RunOptions(**base, seed=seed), out_dir, user=user, observers=observers)
 
     return build

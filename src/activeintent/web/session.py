@@ -34,15 +34,15 @@ SESSION_ID = re.compile(r"^[0-9a-f]{16}$")
 SERVED_FILE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*\.(webm|gif)$")
 
 Status = Literal["waiting-for-learner", "waiting-for-answer", "finished", "failed", "cancelled"]
-# (seed, out_dir, user, on_round) -> Episode
-EpisodeBuilder = Callable[[int, Path, HumanUser, Callable[[Any], None]], Any]
+# (seed, out_dir, user, observers) -> Episode; the session is one of the episode's observers
+EpisodeBuilder = Callable[[int, Path, HumanUser, list[Any]], Any]
 
 
 class StudyConfig(BaseModel):
     """What every session of one `activeintent serve` runs; participants cannot change it."""
 
     method: str
-    signal: Literal["preference", "stop"]
+    signal: str = Field(description="the signal plug-in the study asks for (see activeintent.signals)")
     rounds: int = Field(ge=1, le=100, description="K: signals asked of each participant")
     intention: str | None = None
     show_estimate: bool = Field(True, description="show the learner's current estimate z")
@@ -66,47 +66,9 @@ class VideoInfo(BaseModel):
 
 class RoundInfo(BaseModel):
     round: int
-    feedback: dict
-    preference: str | None = None
-
-
-class _WatchedLearner:
-    """Passes everything to the learner; remembers z so the page can show it, and notes when
-    the final test starts."""
-
-    def __init__(self, inner: Any, session: WebSession):
-        self._inner, self._session = inner, session
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self._inner, name)
-
-    def estimate(self, scene, state):
-        est = self._inner.estimate(scene, state)
-        self._session.estimate = est.preference
-        return est
-
-    def final(self, scene, state):
-        self._session.phase = "final"
-        est = self._inner.final(scene, state)
-        self._session.estimate = est.preference
-        return est
-
-
-class _RecordingEnv:
-    """Passes everything to the simulator; keeps the trajectories of the final test."""
-
-    def __init__(self, inner: Any, session: WebSession):
-        self._inner, self._session = inner, session
-        self.final_trajectories: list[Any] = []
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self._inner, name)
-
-    def execute(self, plan):
-        traj = self._inner.execute(plan)
-        if self._session.phase == "final":
-            self.final_trajectories.append(traj)
-        return traj
+    answer: dict
+    z: str | None = None
+    signals_used: int = 0
 
 
 class WebSession:
@@ -123,6 +85,7 @@ class WebSession:
         self.result: dict | None = None
         self.error: str | None = None
         self.final_video: VideoInfo | None = None
+        self._final_trajectory: Any = None
         self._done = threading.Event()
         self._status_override: Status | None = None
         self._events_lock = threading.Lock()
@@ -146,14 +109,12 @@ class WebSession:
         self._thread.start()
 
     def _run(self) -> None:
-        env = None
+        episode = None
         try:
-            episode = self.builder(self.seed, self.dir, self.user, self._on_round)
-            episode.learner = _WatchedLearner(episode.learner, self)
-            env = episode.env = _RecordingEnv(episode.env, self)
+            episode = self.builder(self.seed, self.dir, self.user, [self])
             result = episode.run()
-            if env.final_trajectories:
-                self.final_video = self._export(env.final_trajectories[0], "final", "final")
+            if self._final_trajectory is not None:
+                self.final_video = self._export(self._final_trajectory, "final", "final")
             self.result = json.loads(result.model_dump_json())
             if result.error:
                 self.error = result.error
@@ -168,10 +129,9 @@ class WebSession:
             self._status_override = "failed"
             self.log_server("session_failed", error=self.error, traceback=traceback.format_exc())
         finally:
-            inner = getattr(env, "_inner", None)
-            if inner is not None and hasattr(inner, "close"):
+            if episode is not None:
                 try:
-                    inner.close()
+                    episode.env.close()
                 except Exception:
                     pass
             self._done.set()
@@ -223,21 +183,30 @@ class WebSession:
         )
         return videos
 
-    def _on_round(self, log: Any) -> None:
-        self.rounds.append(RoundInfo(round=log.round, feedback=log.feedback, preference=log.preference))
+    # -- episode events (worker thread): the session observes the episode --------------------
+    def shown(self, index: int, scene: Any, estimate: Any, trajectories: list[Any]) -> None:
+        self.estimate = estimate.z
+
+    def answered(self, log: Any) -> None:
+        self.rounds.append(RoundInfo(round=log.round, answer=log.answer, z=log.z, signals_used=log.signals_used))
+        if log.signals_used >= self.config.rounds:
+            self.phase = "final"
+
+    def tested(self, k: int, index: int, scene: Any, estimate: Any, traj: Any) -> None:
+        if index == 0:  # the final attempt shown to the participant: the first test scene
+            self._final_trajectory = traj
+            self.estimate = estimate.z
 
     @property
     def signals_used(self) -> int:
-        return sum(
-            1 for r in self.rounds if not r.feedback.get("new_scene") and r.feedback.get("choice") != "new_scene"
-        )
+        return self.rounds[-1].signals_used if self.rounds else 0
 
     # -- the person's side (request threads) -----------------------------------------------
     def answer(self, round: int, make: Callable[[Question], Any], client: dict | None = None):
         if not self.active:
             raise AnswerRejected(f"session {self.id} is {self.status}; it takes no more answers", status=409)
         h = self.user.answer(round, make)
-        self.log_server("answer", round=round, feedback=h.model_dump(), client=client)
+        self.log_server("answer", round=round, answer=h.model_dump(mode="json"), client=client)
         return h
 
     def state(self) -> dict:

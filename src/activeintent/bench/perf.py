@@ -1,0 +1,56 @@
+"""`activeintent perf-bench`: fixed episodes, time per phase, so every change can be judged.
+
+Phases come from the episode's own clock (``EpisodeResult.time_split``): env (physics or the
+symbolic model), learner (its own work, model calls included), executor, user, scoring (the
+hidden intention judged on test scenes), video; ``model_s`` is the part of learner and
+executor spent in model calls.
+"""
+
+from __future__ import annotations
+
+import json
+import statistics
+import time
+from typing import Annotated
+
+import typer
+
+
+def register(app: typer.Typer) -> None:
+    app.command(name="perf-bench")(perf_bench)
+
+
+def perf_bench(
+    as_json: Annotated[bool, typer.Option("--json", help="print JSON")] = False,
+    episodes: Annotated[int, typer.Option(min=1, help="episodes per setting")] = 3,
+    method: Annotated[str, typer.Option("--method")] = "bayes-stop",
+    envs: Annotated[str, typer.Option("--envs", help="comma-separated envs")] = "symbolic,pybullet",
+) -> None:
+    """Time per phase and per episode of fixed `run`-like episodes (no video, no model)."""
+    from activeintent.runner import RunOptions, build_episode
+
+    out: dict = {"method": method, "episodes": episodes, "settings": {}}
+    for env in [e.strip() for e in envs.split(",") if e.strip()]:
+        walls, phases = [], []
+        for seed in range(episodes):
+            options = RunOptions(method=method, intention="color-match", env=env, llm="none", video="none", seed=seed)
+            start = time.perf_counter()
+            episode = build_episode(options)
+            try:
+                result = episode.run()
+            finally:
+                episode.env.close()
+            walls.append(time.perf_counter() - start)
+            phases.append(result.time_split)
+        keys = phases[0].keys()
+        out["settings"][env] = {
+            "episode_s_median": round(statistics.median(walls), 3),
+            "episode_s_max": round(max(walls), 3),
+            "phase_s_mean": {k: round(statistics.fmean(p[k] for p in phases), 3) for k in keys},
+        }
+    if as_json:
+        typer.echo(json.dumps(out, indent=2))
+        return
+    from rich.console import Console
+
+    Console().print_json(json.dumps(out))
