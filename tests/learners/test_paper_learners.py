@@ -18,7 +18,8 @@ from activeintent.learners.retrievers import as_text, prompt_h
 from activeintent.learners.schemas import goal_pattern, goals_schema
 from activeintent.llm.base import ImagePart
 from activeintent.llm.scripted import ScriptedModel
-from activeintent.signals import PreferenceFeedback, StopFeedback
+from activeintent.signals.preference import PreferenceAnswer
+from activeintent.signals.stop import StopAnswer
 from activeintent.world import PutIn, PutNextTo, PutOn, Scene, WorldState, describe_plan, layout
 from helpers import kinematic_trajectory
 
@@ -69,9 +70,9 @@ def test_goal_pattern_accepts_canonical_plans_and_rejects_unknown_objects():
 def test_prompt_h_has_the_three_cases_of_eq3():
     traj = kinematic_trajectory(SCENE, 3, PLAN)  # 2 skills × 3 s
     eps = 2.0
-    none = prompt_h(traj, StopFeedback(stop_time=None), "g", eps)
-    early = prompt_h(traj, StopFeedback(stop_time=1.5, step_index=0), "g", eps)
-    late = prompt_h(traj, StopFeedback(stop_time=4.5, step_index=1), "g", eps)
+    none = prompt_h(traj, StopAnswer(stop_time=None), "g", eps)
+    early = prompt_h(traj, StopAnswer(stop_time=1.5), "g", eps)
+    late = prompt_h(traj, StopAnswer(stop_time=4.5), "g", eps)
     assert none.case == "none" and none.image_labels == []
     assert early.case == "early" and early.image_labels == ["I_0", "I_s"]
     assert late.case == "late" and late.image_labels == ["I_0", "I_b", "I_s"]
@@ -87,11 +88,11 @@ def test_preference_learner_conditions_on_z_y_h_history():
     assert len(est.goals) == 2 and est.goals[0] != est.goals[1]
     first_prompt = model.calls[0].messages[-1].text
     assert "none yet" in first_prompt
-    record = RoundRecord(index=0, scene=SCENE, estimate=est, feedback=PreferenceFeedback(choice="A"))
+    record = RoundRecord(index=0, scene=SCENE, estimate=est, answer=PreferenceAnswer(choice="A"))
     assert learner.observe(record, []) is None
     learner.estimate(SCENE, state())
     eq1 = model.calls[2].messages[-1].text  # eq. 1 for round 2
-    assert est.preference in eq1 and est.goals[0] in eq1 and est.goals[1] in eq1
+    assert est.z in eq1 and est.goals[0] in eq1 and est.goals[1] in eq1
     assert "preferred goal A" in eq1
     eq2 = model.calls[3].messages[-1].text  # eq. 2 conditions on z_{i+1} and the history
     assert "Estimated preference z:" in eq2 and "preferred goal A" in eq2
@@ -102,8 +103,8 @@ def test_mllm_llm_learner_retrieves_r_and_conditions_on_it():
     learner = MllmLlmLearner(model, retriever="symbolic", config=PaperLearnerConfig(design_scenes=False))
     est = learner.estimate(SCENE, state())
     traj = kinematic_trajectory(SCENE, 3, PLAN)
-    h = StopFeedback(stop_time=1.5, step_index=0)
-    r = learner.observe(RoundRecord(index=0, scene=SCENE, estimate=est, feedback=h), [traj])
+    h = StopAnswer(stop_time=1.5)
+    r = learner.observe(RoundRecord(index=0, scene=SCENE, estimate=est, answer=h), [traj])
     assert "put the red block in the green bowl" in r
     learner.estimate(SCENE, state())
     eq5 = model.calls[-2].messages[-1].text
@@ -113,16 +114,16 @@ def test_mllm_llm_learner_retrieves_r_and_conditions_on_it():
 def test_vision_retriever_sends_the_eq3_images(monkeypatch):
     import numpy as np
 
-    from activeintent.sim.trajectory import Trajectory
+    from activeintent.world.trajectory import Trajectory
 
     monkeypatch.setattr(Trajectory, "frame", lambda self, t, size=(240, 240): np.full((*size, 3), int(t * 10), np.uint8))
     llm, vlm = ScriptedModel(respond=responder), ScriptedModel(respond=responder)
     learner = MllmLlmLearner(llm, vlm, retriever="vision", config=PaperLearnerConfig(design_scenes=False))
-    est = Estimate(preference="p", goals=[describe_plan(PLAN)])
+    est = Estimate(z="p", goals=[describe_plan(PLAN)])
     traj = kinematic_trajectory(SCENE, 3, PLAN)
     for stop, n_images in ((None, 0), (1.0, 2), (4.0, 3)):
-        h = StopFeedback(stop_time=stop)
-        learner.observe(RoundRecord(index=0, scene=SCENE, estimate=est, feedback=h), [traj])
+        h = StopAnswer(stop_time=stop)
+        learner.observe(RoundRecord(index=0, scene=SCENE, estimate=est, answer=h), [traj])
         parts = vlm.calls[-1].messages[-1].content
         assert sum(isinstance(p, ImagePart) for p in parts) == n_images  # h = None: x_n, text only
     assert len(vlm.calls) == 3
@@ -131,7 +132,7 @@ def test_vision_retriever_sends_the_eq3_images(monkeypatch):
 def test_mllm_learner_sees_the_images_itself(monkeypatch):
     import numpy as np
 
-    from activeintent.sim.trajectory import Trajectory
+    from activeintent.world.trajectory import Trajectory
 
     monkeypatch.setattr(Trajectory, "frame", lambda self, t, size=(240, 240): np.zeros((*size, 3), np.uint8))
     model = ScriptedModel(respond=responder, accepts_images=True)
@@ -139,7 +140,7 @@ def test_mllm_learner_sees_the_images_itself(monkeypatch):
     assert learner.retriever == "vision"
     est = learner.estimate(SCENE, state())
     traj = kinematic_trajectory(SCENE, 3, PLAN)
-    learner.observe(RoundRecord(index=0, scene=SCENE, estimate=est, feedback=StopFeedback(stop_time=4.0)), [traj])
+    learner.observe(RoundRecord(index=0, scene=SCENE, estimate=est, answer=StopAnswer(stop_time=4.0)), [traj])
     learner.estimate(SCENE, state())
     parts = model.calls[-2].messages[-1].content
     assert sum(isinstance(p, ImagePart) for p in parts) == 3
@@ -152,3 +153,43 @@ def test_scene_design_falls_back_on_unusable_choice():
 
     assert learner.design_scene(np.random.default_rng(0)) is None  # no blocks: unusable
     assert "unusable" in learner.drain_transcript()[-1]
+
+
+def test_the_skill_at_the_stop_comes_from_the_trajectory_not_the_answer():
+    # a person's stop is only a time: the retriever finds the step being executed itself
+    traj = kinematic_trajectory(SCENE, 3, PLAN)
+    early = as_text(prompt_h(traj, StopAnswer(stop_time=1.5), "g", 2.0), traj)
+    late = as_text(prompt_h(traj, StopAnswer(stop_time=4.5), "g", 2.0), traj)
+    assert "put the red block in the green bowl" in early and "put the blue block on the red block" not in early
+    assert "put the blue block on the red block" in late
+
+
+def test_stop_learner_takes_a_new_scene_answer_without_retrieving():
+    model = ScriptedModel(respond=responder)
+    learner = MllmLlmLearner(model, retriever="symbolic", config=PaperLearnerConfig(design_scenes=False))
+    est = learner.estimate(SCENE, state())
+    traj = kinematic_trajectory(SCENE, 3, PLAN)
+    r = learner.observe(RoundRecord(index=0, scene=SCENE, estimate=est, answer=StopAnswer(new_scene=True)), [traj])
+    assert r is None
+    learner.estimate(SCENE, state())
+    eq5 = model.calls[-2].messages[-1].text
+    assert "new scene" in eq5 and "r_1:" not in eq5
+
+
+def test_symbolic_retrieval_does_not_read_a_failed_execution_as_approval():
+    from activeintent.learners.retrievers import symbolic_retrieval
+
+    nothing = kinematic_trajectory(SCENE, 3, [])
+    ph = prompt_h(nothing, StopAnswer(), "g", 2.0)
+    assert "nothing moved" in symbolic_retrieval(ph, nothing, StopAnswer())
+    moved = kinematic_trajectory(SCENE, 3, PLAN)
+    watched = symbolic_retrieval(prompt_h(moved, StopAnswer(), "g", 2.0), moved, StopAnswer())
+    assert "watched the whole execution" in watched
+
+
+def test_vision_retriever_needs_a_model_that_sees_images():
+    from activeintent.llm.base import ModelError
+
+    blind = ScriptedModel(respond=responder, accepts_images=False)
+    with pytest.raises(ModelError, match="accepts no images"):
+        MllmLlmLearner(blind, retriever="vision")
