@@ -196,7 +196,7 @@ def test_one_wrong_preference_leaves_the_true_hypothesis_recoverable():
     observe(learner, SCENE, STATE, PreferenceAnswer(choice="B"), trajs)  # a lapse: truth is "same bowl"
     after = weights_by_name(learner)["all:in-same-bowl"]
     floor = learner.model.lapse / 3 * (1 - learner.config.new_scene_error)  # P(h | z) never below this
-    assert after >= prior * floor
+    assert prior * floor <= after < prior  # it loses weight, but never all of it
     for k in range(1, 4):
         observe(learner, SCENE, STATE, PreferenceAnswer(choice="A"), trajs, index=k)
     assert learner.top()[0][0].name == "all:in-same-bowl"
