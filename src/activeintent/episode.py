@@ -54,7 +54,7 @@ class EpisodeConfig(BaseModel):
     test_scenes: int = Field(DEFAULT_TEST_SCENES, ge=1, le=200)
     new_scene: NewSceneRule = "counted"
     stop_when_done: bool = Field(False, description="end early when a learner allowed to finish says done (not in benchmarks)")
-    curve: bool = Field(True, description="score after every signal (False: only at k = 0 and K)")
+    curve: bool = Field(True, description="score after every signal (False: only at k = K)")
     max_goal_retries: int = Field(1, ge=0, description="re-asks when y cannot be turned into motion")
     video: str = Field("none", pattern="^(none|final|all)$", description="GIFs written: none, the final test, or all")
     video_fps: int = 10
@@ -301,7 +301,10 @@ class Episode:
         after_new_scene = False
         physics = self.env.name != "symbolic"
         try:
-            rate, test_logs = self._score(0, tests, physics and cfg.budget == 0)
+            if cfg.curve or cfg.budget == 0 or not self.learner.asks:
+                rate, test_logs = self._score(0, tests, physics and cfg.budget == 0)
+            else:  # slow learners (model calls) are scored at k = K only
+                rate = None
             success_at.append(rate)
             while self.learner.asks and signals < cfg.budget:
                 log = self._round(len(logs), scene_rng, layout_rng, learner_rng, after_new_scene)

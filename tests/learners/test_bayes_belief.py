@@ -171,10 +171,6 @@ def test_no_query_without_distinct_candidates():
     assert all(o.plan for o in outs)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "src bug: judge.judge() memoises verdicts in the global Facts cache under ('judge', id(hyps)); "
-    "once a hypothesis tuple is freed, a new tuple of the same size reuses its id and is handed "
-    "the old tuple's verdicts (e.g. the `sub` tuple of a second proposal round in BayesLearner._propose)"))
 def test_judges_of_different_hypothesis_tuples_do_not_share_verdicts():
     state = WorldState(positions=layout(SCENE, 0))
     end = symbolic_trajectory(SCENE, state, [PutIn(block="red block", bowl="red bowl"),

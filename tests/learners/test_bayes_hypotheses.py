@@ -89,7 +89,6 @@ def test_every_named_intention_has_an_agreeing_hypothesis(hyps):
     """For each built-in intention some hypothesis has the same satisfied() on many states:
     initial layouts, the intention's plans and other hypotheses' plans in its feasible scenes."""
     from activeintent.intentions.registry import all_intentions
-    from activeintent.learners.bayes.symbolic import agreement_states
 
     for intention in all_intentions():
         states = agreement_states(intention, hyps, n_scenes=5, seed=3)
@@ -97,3 +96,23 @@ def test_every_named_intention_has_an_agreeing_hypothesis(hyps):
         assert any(truth) and not all(truth)
         match = [h for h in hyps if all(h.satisfied(s) == t for s, t in zip(states, truth, strict=True))]
         assert match, f"no hypothesis agrees with {intention.name}"
+
+
+def agreement_states(intention, hyps, n_scenes: int = 6, seed: int = 0) -> list:
+    """States to compare an intention with hypotheses: initial layouts of scenes feasible for
+    it, its own plan's outcome, and the outcomes of the feasible hypotheses' plans."""
+    import numpy as np
+
+    from activeintent.world import WorldState, apply_plan, layout
+
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(n_scenes):
+        scene = intention.sample_scene(rng)
+        state = WorldState(positions=layout(scene, seed * 100 + i))
+        out.append(state)
+        for plan in [intention.plan(state)] + [h.plan(state) for h in hyps if h.feasible(scene)]:
+            if plan:
+                states, _ = apply_plan(state, plan)
+                out.append(states[-1])
+    return out

@@ -143,10 +143,7 @@ def no_stop_rate_of_the_model(u: SimulatedUser, t) -> float:
         (GOOD_STACK, {"false_stop": 0.1, "lapse": 0.2}),
         (BAD_SECOND, {"missed_stop": 0.3}),
         (BAD_SECOND, {"missed_stop": 0.2, "lapse": 0.3, "late_tail": 0.5}),
-        pytest.param(BAD_SECOND, {"missed_stop": 0.3, "false_stop": 0.2}, marks=pytest.mark.xfail(
-            strict=True, reason="src bug: StopSignal.sample draws a false stop independently of a missed "
-            "bad move (P(no stop) = missed·(1 − false)), StopSignal.likelihood treats them as exclusive "
-            "(P(no stop) = missed)")),
+        (BAD_SECOND, {"missed_stop": 0.3, "false_stop": 0.2}),
     ],
 )
 def test_no_stop_frequency_matches_the_stop_model(plan, stop):
@@ -211,10 +208,8 @@ def test_respond_needs_one_trajectory():
 
 @pytest.mark.parametrize("stop", [
     {"delay_sd": 0.2, "false_stop": 0.3, "missed_stop": 0.3},
-    {"delay_sd": 0.2, "lapse": 0.5},  # a lapse draws once more, but whatever was shown
-    pytest.param({"delay_sd": 0.2, "late_tail": 0.5}, marks=pytest.mark.xfail(strict=True, reason=(
-        "src bug: StopSignal.sample draws one more uniform for a late-tail press, which only "
-        "happens when a step moved away, although it says every answer uses a fixed number of draws"))),
+    {"delay_sd": 0.2, "lapse": 0.5},
+    {"delay_sd": 0.2, "late_tail": 0.5},
 ])
 def test_the_random_stream_does_not_depend_on_what_was_shown(stop):
     # same seed, different trajectories: the generator must end in the same state, so that a

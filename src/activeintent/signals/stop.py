@@ -111,22 +111,22 @@ class StopSignal(Signal):
     def sample(self, shown, judge, model: StopModel, rng) -> StopAnswer:
         traj = self._one(shown)
         away = int(judge.first_away(traj)[0])
-        # Fixed number of draws per answer, so user noise streams stay aligned across methods.
-        u_miss, u_false, u_tail, u_lapse = rng.random(4)
-        t_false, t_any = rng.uniform(0.0, max(traj.duration, 1e-6), 2)
+        # The same draws for every answer, so user noise streams stay aligned across methods
+        # whatever was shown; the events are exclusive, as in ``likelihood``.
+        u_event, u_tail, u_lapse, u_coin = rng.random(4)
+        t_false, t_any, t_late = rng.uniform(0.0, 1.0, 3)
         delay = _delay_sample(model, rng)
+        end = max(traj.duration, 1e-6)
         if u_lapse < model.lapse:
-            return self.answer_at(traj, t_any if rng.random() < 0.5 else None)
-        presses = []
-        if away >= 0 and u_miss >= model.missed_stop:
-            visible, start = _times(traj, model)
-            if u_tail < model.late_tail:
-                presses.append(float(rng.uniform(start[away], max(traj.duration, start[away]))))
-            else:
-                presses.append(float(visible[away]) + delay)
-        if u_false < model.false_stop:
-            presses.append(float(t_false))
-        return self.answer_at(traj, min(presses) if presses else None)
+            return self.answer_at(traj, t_any * end if u_coin < 0.5 else None)
+        if u_event < model.false_stop:
+            return self.answer_at(traj, t_false * end)
+        if away < 0 or u_event < model.false_stop + model.missed_stop:
+            return StopAnswer()
+        visible, start = _times(traj, model)
+        if u_tail < model.late_tail:
+            return self.answer_at(traj, start[away] + t_late * max(end - start[away], 0.0))
+        return self.answer_at(traj, float(visible[away]) + delay)
 
     def likelihood(self, answer: StopAnswer, shown, judge, model: StopModel) -> np.ndarray:
         traj = self._one(shown)
@@ -158,7 +158,9 @@ class StopSignal(Signal):
         p[has, away[has]] += 1 - model.false_stop - model.missed_stop
         p[has, n] += model.missed_stop
         p[~has, n] += 1 - model.false_stop
-        return (1 - model.lapse) * p + model.lapse / (n + 1)
+        lapse = np.full(n + 1, model.lapse / (2 * n))  # as in likelihood: half stop somewhere, half no stop
+        lapse[n] = model.lapse / 2
+        return (1 - model.lapse) * p + lapse
 
 
 SIGNALS.register("stop", StopSignal, help="the time the person pressed stop while the robot worked, or none")

@@ -63,7 +63,7 @@ class IntentionJudge:
 class UserProfile(BaseModel):
     """Every parameter of a simulated user (logged with each result, never shown to learners)."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", ser_json_inf_nan="constants")
 
     name: str = "custom"
     models: dict[str, dict[str, Any]] = Field(

@@ -266,7 +266,7 @@ def runner_builder(config: StudyConfig, **options: Any) -> EpisodeBuilder:
     """Sessions built by :func:`activeintent.runner.build_episode` (method, intention, rounds
     from the study; ``options`` are further RunOptions fields, e.g. llm)."""
     # People watch physics; the session exports its own videos; the learner is scored on the
-    # test scenes before the first and after the last answer only (no one waits for a curve).
+    # test scenes after the last answer only (no one waits for a curve).
     base = {"method": config.method, "budget": config.rounds, "env": "pybullet", "video": "none",
             "curve": False, **options}
     if config.intention is not None:

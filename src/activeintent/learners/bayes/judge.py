@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from activeintent.learners.bayes.facts import Facts, facts
@@ -9,10 +11,15 @@ from activeintent.learners.bayes.hypotheses import Hypothesis
 from activeintent.world import WorldState
 from activeintent.world.trajectory import Trajectory
 
+_TOKENS = itertools.count()
 
-def judge(hyps: tuple[Hypothesis, ...], f: Facts) -> tuple[np.ndarray, np.ndarray]:
-    """(satisfied, score) of one state under every hypothesis (memoised on the facts)."""
-    key = ("judge", id(hyps))
+
+def judge(hyps: tuple[Hypothesis, ...], f: Facts, token: object = None) -> tuple[np.ndarray, np.ndarray]:
+    """(satisfied, score) of one state under every hypothesis, memoised on the facts under
+    ``token`` (unique per judge: an id() could be reused by a later tuple)."""
+    if token is None:
+        token = tuple(h.name for h in hyps)
+    key = ("judge", token)
     got = f.memo.get(key)
     if got is None:
         sat = np.fromiter((h.holds_f(f) for h in hyps), bool, len(hyps))
@@ -34,7 +41,7 @@ def trajectory_steps(traj: Trajectory) -> Steps:
     return [(facts(s.state_before), facts(s.state_after), s.skill.block, s.ok) for s in traj.steps]
 
 
-def first_away(hyps: tuple[Hypothesis, ...], steps: Steps) -> np.ndarray:
+def first_away(hyps: tuple[Hypothesis, ...], steps: Steps, token: object = None) -> np.ndarray:
     """Per hypothesis, the index of the first step that moves away from it (-1: none).
     A failed step counts only when it made things worse (its score dropped)."""
     out = np.full(len(hyps), -1)
@@ -44,8 +51,8 @@ def first_away(hyps: tuple[Hypothesis, ...], steps: Steps) -> np.ndarray:
             break
         if fb is fa:
             continue
-        _, sb = judge(hyps, fb)
-        _, sa = judge(hyps, fa)
+        _, sb = judge(hyps, fb, token)
+        _, sa = judge(hyps, fa, token)
         drop = sa < sb - 1e-9
         for i in todo:
             if drop[i] or (ok and hyps[i].moved_off(fb, fa, block)):
@@ -59,13 +66,17 @@ class HypothesisJudge:
     def __init__(self, hyps: tuple[Hypothesis, ...]):
         self.hyps = hyps
         self.size = len(hyps)
+        self.token = next(_TOKENS)
         self._away: dict[int, tuple[Trajectory, np.ndarray]] = {}
 
-    def utility(self, state: WorldState) -> np.ndarray:
-        f = facts(state)
+    def judge(self, f: Facts) -> tuple[np.ndarray, np.ndarray]:
+        """(satisfied, score) of the state behind ``f`` under every hypothesis."""
         for h in self.hyps:
             h.prefetch([f])
-        sat, score = judge(self.hyps, f)
+        return judge(self.hyps, f, self.token)
+
+    def utility(self, state: WorldState) -> np.ndarray:
+        sat, score = self.judge(facts(state))
         return utility(score, sat)
 
     def first_away(self, traj: Trajectory) -> np.ndarray:
@@ -75,7 +86,7 @@ class HypothesisJudge:
         steps = trajectory_steps(traj)
         for h in self.hyps:
             h.prefetch([f for st in steps for f in st[:2]])
-        away = first_away(self.hyps, steps)
+        away = first_away(self.hyps, steps, self.token)
         if len(self._away) > 4096:
             self._away.clear()
         self._away[id(traj)] = (traj, away)  # keeps τ alive so its id is not reused

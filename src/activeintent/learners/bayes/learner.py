@@ -27,7 +27,7 @@ from activeintent.learners.bayes.belief import Belief, Prior
 from activeintent.learners.bayes.candidates import candidate_plans, predict
 from activeintent.learners.bayes.facts import facts
 from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space, random_scene
-from activeintent.learners.bayes.judge import HypothesisJudge, judge
+from activeintent.learners.bayes.judge import HypothesisJudge
 from activeintent.llm.base import ChatModel, ModelError
 from activeintent.signals import Answer, Signal, get_signal
 from activeintent.world import (
@@ -218,7 +218,7 @@ class BayesLearner(Learner):
         finals = [facts(o.traj.outcome) for o in outs]
         for h in self.hyps:
             h.prefetch(finals)
-        success = np.array([float(w @ judge(self.hyps, f)[0]) for f in finals])
+        success = np.array([float(w @ self.judge.judge(f)[0]) for f in finals])
         best = int(np.argmax(success - 1e-6 * np.array([len(o.plan) for o in outs])))
         top = self.hyps[int(np.argmax(w))]
         plan = outs[best].plan
