@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from activeintent.world.trajectory import StepRecord, Trajectory
 from activeintent.world import Scene, Skill, WorldState, apply_skill, layout
+from activeintent.world.trajectory import StepRecord, Trajectory
 
 STEP_TICKS = 30  # ticks per skill; with dt = 0.1 s a skill takes 3 s
 REVEAL = 10

@@ -8,7 +8,6 @@ import pytest
 
 from activeintent.sim.env import SimConfig, TabletopEnv
 from activeintent.sim.render import render_frame, render_state
-from activeintent.world.trajectory import Trajectory
 from activeintent.sim.video import export_video, frame_times
 from activeintent.world import (
     BLOCK_SIZE,
@@ -22,6 +21,7 @@ from activeintent.world import (
     relations,
     table_position_name,
 )
+from activeintent.world.trajectory import Trajectory
 
 SCENE = ["red block", "green block", "yellow block", "blue bowl", "purple bowl"]
 PLAN = [
