@@ -41,7 +41,9 @@ def bench(
     executor: opt.Executor = D.executor,
     retriever: opt.Retriever = D.retriever,
     curve: Annotated[bool, typer.Option(help="Score after every signal (off: only at k = K; for slow models)")] = True,
-    jobs: Annotated[int, typer.Option("--jobs", min=1, help="Episodes run in parallel (processes)")] = 1,
+    jobs: Annotated[int, typer.Option("--jobs", min=1, help="Episodes run in parallel (processes; with --backend ray and no cluster: the CPUs of the local Ray)")] = 1,
+    backend: Annotated[str, typer.Option("--backend", help="local (process pool) | ray (one task per episode; docs/scaling.md)")] = "local",
+    ray_address: Annotated[str | None, typer.Option("--ray-address", help="With --backend ray: cluster to use (e.g. auto); default $RAY_ADDRESS, else a local Ray")] = None,
     keep_episodes: Annotated[bool, typer.Option(help="Keep each episode's rounds.jsonl and summary.json")] = False,
     retry_errors: Annotated[bool, typer.Option(help="Re-run episodes that ended in an error")] = False,
     out: Annotated[Path, typer.Option("--out", help="Results folder; re-running with it resumes")] = Path("runs/bench"),
@@ -58,6 +60,7 @@ def bench(
         TimeRemainingColumn,
     )
 
+    from activeintent.bench.backends import check_backend
     from activeintent.bench.report import plot_success_vs_signals, write_report
     from activeintent.bench.runner import BenchOptions, protocol_fields, run_bench
     from activeintent.runner import check_options
@@ -66,6 +69,7 @@ def bench(
 
     console = Console()
     try:
+        check_backend(backend)
         run = opt.run_options(plugins=plugin, budget=budget, test_scenes=test_scenes, env=env, user=user,
                               new_scene=new_scene, prior=prior, llm=llm, vlm=vlm, base_url=base_url, cache=cache,
                               cache_mode=cache_mode, executor=executor, retriever=retriever, curve=curve, video="none")
@@ -83,7 +87,8 @@ def bench(
         console.print(f"[red]error:[/red] {err}")
         raise typer.Exit(2) from None
     options = BenchOptions(methods=method_list, intentions=intention_list, intention_files=list(intention_file or []),
-                           trials=trials, seed=seed, jobs=jobs, retry_errors=retry_errors,
+                           trials=trials, seed=seed, jobs=jobs, backend=backend, ray_address=ray_address,
+                           retry_errors=retry_errors,
                            keep_episodes=keep_episodes, run=run)
     progress = Progress(TextColumn("[bold]bench"), BarColumn(), MofNCompleteColumn(), TextColumn("episodes"),
                         TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(), TextColumn("{task.description}"),

@@ -46,6 +46,8 @@ class BenchOptions(BaseModel):
     trials: int = Field(20, ge=1)
     seed: int = Field(0, ge=0)
     jobs: int = Field(1, ge=1)
+    backend: str = Field("local", pattern="^(local|ray)$")  # not a setting: a bench may resume on another
+    ray_address: str | None = None  # with backend ray: an existing cluster (else RAY_ADDRESS, else a local Ray)
     retry_errors: bool = False
     keep_episodes: bool = False  # per-episode folders (rounds.jsonl, summary.json)
     run: RunOptions = Field(default_factory=lambda: RunOptions(video="none"))
@@ -132,6 +134,11 @@ def _check_same_settings(options: BenchOptions, path: Path) -> None:
 
 
 def _execute(todo: list[WorkItem], options: BenchOptions, out: Path) -> Iterator[dict]:
+    if options.backend == "ray":
+        from activeintent.bench.backends import execute_ray
+
+        yield from execute_ray(todo, options, out)
+        return
     args = (options.run, options.seed, str(out), options.keep_episodes)
     if options.jobs <= 1:
         for item in todo:
