@@ -141,7 +141,7 @@ def scripted_answers(messages, schema):
 
 def test_an_ungroundable_goal_then_no_stop_is_a_failed_execution_not_approval(tmp_path):
     model = ScriptedModel(respond=scripted_answers, accepts_images=False)
-    learner = get_method("mllm-llm")(LearnerContext(llm=model))
+    learner = get_method("mllm-llm")(LearnerContext(llm=model, variant="structured"))
     user = ScriptedUser("stop", [{"stop_time": None}])
     # An executor that can ground nothing: every y fails to become motion.
     executor = make_executor("parse")
@@ -157,7 +157,7 @@ def test_an_ungroundable_goal_then_no_stop_is_a_failed_execution_not_approval(tm
 
 def test_model_calls_are_counted_when_built_from_python():
     model = ScriptedModel(respond=scripted_answers, accepts_images=False)
-    learner = get_method("preference")(LearnerContext(llm=model))
+    learner = get_method("preference")(LearnerContext(llm=model, variant="structured"))
     user = SimulatedUser(resolve("color-match"), "preference", user_profile("exact"), rng=0)
 
     def usage():

@@ -93,6 +93,8 @@ def run(
     unsafe_no_isolation: opt.UnsafeNoIsolation = False,
     retriever: opt.Retriever = D.retriever,
     epsilon: opt.Epsilon = D.epsilon,
+    early_threshold: opt.EarlyThreshold = D.early_threshold,
+    variant: opt.Variant = D.variant,
     video: opt.Video = D.video,
     design_scenes: bool = typer.Option(D.design_scenes, help="Let the learner choose each round's objects"),
     out: opt.Out = None,
@@ -114,7 +116,8 @@ def run(
             method=method, intention=intention, intention_file=intention_file, plugins=plugin, budget=budget,
             seed=seed, test_scenes=test_scenes, env=env, user=user, new_scene=new_scene, prior=prior, llm=llm,
             vlm=vlm, base_url=base_url, cache=cache, cache_mode=cache_mode, executor=executor,
-            retriever=retriever, epsilon=epsilon, video=video, design_scenes=design_scenes,
+            retriever=retriever, epsilon=epsilon, early_threshold=early_threshold, variant=variant, video=video,
+            design_scenes=design_scenes,
             )
     except ValueError as err:
         console.print(f"[red]error:[/red] {err}")

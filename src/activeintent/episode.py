@@ -102,6 +102,7 @@ class RoundLog(BaseModel):
     signals_used: int  # counted answers so far, this one included
     retrieved: str | None
     retriever: str | None
+    variant: str | None = None  # the paper methods' variant (faithful | structured)
     done: bool
     why: dict = Field(default_factory=dict)
     calls: list[dict] = Field(default_factory=list)
@@ -142,6 +143,7 @@ class EpisodeResult(BaseModel):
     final_z: str = ""
     final_goal: str = ""
     retriever: str | None = None
+    variant: str | None = None
     llm_calls: int = 0
     prompt_tokens: int = 0
     completion_tokens: int = 0
@@ -222,6 +224,11 @@ class Episode:
         failure = result.failure.feedback_text() if result.failure else None
         return list(result.plan), failure
 
+    def _executor_calls(self) -> list[dict]:
+        """The executor's model calls since the last drain (y → program/plan), if it keeps them."""
+        drain = getattr(self.executor, "drain_transcript", None)
+        return drain() if drain is not None else []
+
     def _ground(self, ask: Callable[[Scene, WorldState], Estimate], scene: Scene, state: WorldState
                 ) -> tuple[Estimate, list[list[Skill]], list[str | None]]:
         """z, y from the learner and y turned into plans; y that cannot be grounded is sent back
@@ -277,6 +284,7 @@ class Episode:
                     self._video(traj, "final")
             logs.append(log)
         self.learner.drain_transcript()  # scoring calls are not part of any round's record
+        self._executor_calls()
         scored = [t.success for t in logs if t.feasible]
         rate = float(np.mean(scored)) if scored else None
         self.emit("scored", k, rate)
@@ -359,6 +367,7 @@ class Episode:
             final_z=test_logs[0].z if test_logs else "",
             final_goal=test_logs[0].goal if test_logs else "",
             retriever=self.learner.retriever,
+            variant=getattr(self.learner, "variant", None),
             llm_calls=calls1[0] - calls0[0],
             prompt_tokens=calls1[1] - calls0[1],
             completion_tokens=calls1[2] - calls0[2],
@@ -405,7 +414,8 @@ class Episode:
             z=est.z, goals=est.goals, labels=labels, plans=[describe_plan(p) for p in plans], failures=failures,
             executed=[t.moved_anything for t in trajectories], answer=h.model_dump(mode="json"), counted=True,
             signals_used=0, retrieved=r, retriever=self.learner.retriever, done=est.done, why=est.why,
-            calls=self.learner.drain_transcript(),
+            variant=getattr(self.learner, "variant", None),
+            calls=self.learner.drain_transcript() + self._executor_calls(),
             timing={k: round(v - t0[k], 4) for k, v in self.clock.split.items()},
         )
 

@@ -32,6 +32,8 @@ Executor = Annotated[str, typer.Option("--executor", help="y → plan: parse | p
 UnsafeNoIsolation = Annotated[bool, typer.Option("--unsafe-no-isolation", envvar="ACTIVEINTENT_UNSAFE_NO_ISOLATION", help="Run model-written code (--executor cap, proposed predicates) even without the bubblewrap sandbox (docs/security.md)")]
 Retriever = Annotated[str, typer.Option("--retriever", help="r from a stop: symbolic | vision")]
 Epsilon = Annotated[float, typer.Option("--epsilon", min=0.0, help="ε: seconds before the stop for image I_b")]
+EarlyThreshold = Annotated[float, typer.Option("--early-threshold", min=0.0, help="eq. 3: a stop earlier than this (s) shows no I_b")]
+Variant = Annotated[str, typer.Option("--variant", help="Paper methods: faithful (free text, reasoning, memory, T = 1) | structured")]
 Video = Annotated[str, typer.Option("--video", help="GIFs written: none | final | all")]
 Out = Annotated[Path | None, typer.Option("--out", help="Output folder")]
 

@@ -44,6 +44,8 @@ class RunOptions(BaseModel):
     executor: str = "plan"
     retriever: str = Field("symbolic", pattern="^(symbolic|vision)$")
     epsilon: float = Field(2.0, ge=0)
+    early_threshold: float = Field(2.0, ge=0)
+    variant: str = Field("faithful", pattern="^(faithful|structured)$")
     design_scenes: bool = True
     video: str = Field("final", pattern="^(none|final|all)$")
     curve: bool = True
@@ -128,8 +130,9 @@ def build_episode(
     llm = models.llm
     learner = method(LearnerContext(llm=llm, vlm=models.vlm, retriever=options.retriever, seed=seeds.learner,
                                     design_scenes=options.design_scenes, epsilon=options.epsilon,
-                                    prior=options.prior))
-    executor = make_executor(options.executor, model=llm)
+                                    prior=options.prior, variant=options.variant,
+                                    early_threshold=options.early_threshold))
+    executor = make_executor(options.executor, model=llm, parser_first=options.variant == "structured")
     if user is None:
         user = SimulatedUser(intention, method.signal, user_profile(options.user), rng=seeds.user)
         if options.new_scene == "off":

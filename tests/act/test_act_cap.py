@@ -145,10 +145,24 @@ def test_executor_runs_model_program(sandbox, state):
     assert "# put the blocks in the bowls of their colour." in model.last_prompt
 
 
-def test_canonical_instruction_skips_the_model(sandbox, state):
+def test_canonical_instruction_skips_the_model_only_parser_first(sandbox, state):
     model = ScriptedModel([])
-    result = CapExecutor(model, sandbox=sandbox).to_plan("put the red block in the red bowl", state)
+    result = CapExecutor(model, sandbox=sandbox, parser_first=True).to_plan("put the red block in the red bowl", state)
     assert result.ok and result.source == "parse" and model.calls == []
+    # Code as Policies proper: a program is written for every y, even a canonical one.
+    model = ScriptedModel(["put_first_on_second('red block', 'red bowl')"])
+    executor = CapExecutor(model, sandbox=sandbox)
+    result = executor.to_plan("put the red block in the red bowl", state)
+    assert result.ok and result.source == "cap" and len(model.calls) == 1
+    (call,) = executor.drain_transcript()
+    assert call["program"] == "put_first_on_second('red block', 'red bowl')"
+    assert call["plan"] == "put the red block in the red bowl"
+
+
+def test_multi_line_instruction_becomes_one_comment(sandbox, state):
+    model = ScriptedModel(["put_first_on_second('red block', 'red bowl')"])
+    CapExecutor(model, sandbox=sandbox).to_plan("sort the blocks:\nred goes to red.", state)
+    assert "# sort the blocks: red goes to red.\n" in model.last_prompt + "\n"
 
 
 def test_program_without_robot_calls_fails(sandbox, state):

@@ -56,10 +56,24 @@ def test_plan_executor_uses_the_model_for_free_text(state):
     assert "purple" not in json.dumps(model.calls[0].json_schema)
 
 
-def test_plan_executor_parses_first(state):
+def test_plan_executor_parses_first_only_when_asked(state):
     model = ScriptedModel([])
-    result = PlanExecutor(model).to_plan("put the red block at the middle", state)
+    result = PlanExecutor(model, parser_first=True).to_plan("put the red block at the middle", state)
     assert result.plan == [PutAt(block="red block", position="middle")] and model.calls == []
+    # By default every y goes to the model, canonical or not, and the call is kept.
+    model = ScriptedModel([{"steps": [{"skill": "put_at", "block": "red block", "position": "middle"}]}])
+    executor = PlanExecutor(model)
+    result = executor.to_plan("put the red block at the middle", state)
+    assert result.ok and result.source == "plan" and len(model.calls) == 1
+    (call,) = executor.drain_transcript()
+    assert call["instruction"] == "put the red block at the middle" and call["plan"] and call["failure"] is None
+    assert executor.drain_transcript() == []
+
+
+def test_an_empty_instruction_fails_without_a_model_call(state):
+    model = ScriptedModel([])
+    result = PlanExecutor(model).to_plan("  \n ", state)
+    assert result.failure is not None and result.failure.stage == "parse" and model.calls == []
 
 
 def test_invalid_model_answer_is_a_plan_failure(state):

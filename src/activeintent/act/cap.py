@@ -32,17 +32,17 @@ class CapExecutor(Executor):
 
     name = "cap"
 
-    def __init__(self, model: ChatModel | None = None, *, sandbox: Sandbox | None = None, max_tokens: int = 512) -> None:
-        super().__init__(model)
+    def __init__(self, model: ChatModel | None = None, *, sandbox: Sandbox | None = None, max_tokens: int = 512,
+                 parser_first: bool = False) -> None:
+        super().__init__(model, parser_first=parser_first)
         if sandbox is None and model is not None:
             require_isolation()  # refuse now, with the reason, rather than at every program
         self.sandbox = sandbox
         self.max_tokens = max_tokens
 
     def messages(self, instruction: str, state: WorldState) -> tuple[list[Message], str]:
-        prompt, version = render_prompt(
-            "executor_cap", objects=repr(list(state.names)), instruction=instruction.strip().rstrip(".")
-        )
+        one_line = " ".join(instruction.split()).rstrip(".")  # y goes into one comment line
+        prompt, version = render_prompt("executor_cap", objects=repr(list(state.names)), instruction=one_line)
         return [Message(role="user", content=prompt)], version
 
     def _from_model(self, instruction: str, state: WorldState) -> PlanResult:

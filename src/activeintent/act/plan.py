@@ -76,8 +76,8 @@ class PlanExecutor(Executor):
 
     name = "plan"
 
-    def __init__(self, model: ChatModel | None = None, *, max_tokens: int = 400) -> None:
-        super().__init__(model)
+    def __init__(self, model: ChatModel | None = None, *, max_tokens: int = 400, parser_first: bool = False) -> None:
+        super().__init__(model, parser_first=parser_first)
         self.max_tokens = max_tokens
 
     def messages(self, instruction: str, state: WorldState) -> tuple[list, str]:

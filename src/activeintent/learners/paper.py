@@ -1,4 +1,6 @@
-"""The paper's three learners: `preference` (eq. 1–2), `mllm-llm` (eq. 3–6), `mllm`.
+"""The paper's three learners, ``--variant structured``: `preference` (eq. 1–2), `mllm-llm`
+(eq. 3–6), `mllm`. The paper's own way of running them (free text, reasoning, multi-turn
+memory, sampling) is ``--variant faithful``, the default, in :mod:`activeintent.learners.faithful`.
 
 Each round the model p_θ estimates the intention z_{i+1} from the history, then the
 instruction(s) y_{i+1} given z_{i+1}; stop-signal methods first turn the user's stop h_i into
@@ -8,6 +10,7 @@ by line.
 
 from __future__ import annotations
 
+import re
 import time
 from typing import Literal
 
@@ -36,15 +39,28 @@ from activeintent.world import ALL_OBJECTS, Scene, SceneError, WorldState, descr
 from activeintent.world.trajectory import Trajectory
 
 
+def failure_reason(text: str | None) -> str:
+    """The reason alone from an executor's feedback text ("I failed to generate the goal; please
+    generate a simpler goal … Reason (stage): why"): learners phrase the request for a simpler
+    goal themselves, so it is not said twice."""
+    text = (text or "").strip()
+    if m := re.search(r"Reason \((\w+)\): (.*)$", text, re.DOTALL):
+        return f"{m[1]} failed: {m[2].strip()}"
+    return text or "no reason given"
+
+
 class PaperLearnerConfig(BaseModel):
     design_scenes: bool = True  # the learner chooses the objects of each round's scene
     epsilon: float = 2.0  # ε: seconds before the stop for the image I_b (eq. 3)
+    early_threshold: float | None = None  # eq. 3's "h < ε": a stop before this shows no I_b (None: ε)
     image_size: int = 240
     max_tokens: int = 256
 
 
 class _ModelLearner(Learner):
     """Shared plumbing: model calls with a transcript, history text, scene design."""
+
+    variant = "structured"
 
     def __init__(self, llm: ChatModel, config: PaperLearnerConfig | None = None):
         self.llm = llm
@@ -75,11 +91,12 @@ class _ModelLearner(Learner):
         out, self.transcript = self.transcript, []
         return out
 
+    def stats(self) -> dict:
+        return {"variant": self.variant}
+
     def execution_failed(self, goal: str, reason: str) -> None:
-        self.notes.append(
-            f'I failed to generate the goal "{goal}" ({reason}); please generate a simpler goal '
-            "similar to the previous one."
-        )
+        self.notes.append(f'I failed to generate the goal "{goal}" ({failure_reason(reason)}); please generate '
+                          "a simpler goal similar to the previous one.")
 
     # -- scene design ------------------------------------------------------------------------
     def design_scene(self, rng: np.random.Generator) -> Scene | None:
@@ -223,7 +240,7 @@ class MllmLlmLearner(_StopLearner):
         r = None
         if trajectories and not h.new_scene:
             traj, goal = trajectories[0], record.estimate.goals[0]
-            ph = prompt_h(traj, h, goal, self.config.epsilon)
+            ph = prompt_h(traj, h, goal, self.config.epsilon, self.config.early_threshold)
             if self.retriever == "vision":
                 past = "\n".join(f"y: {rec.estimate.goals[0]}; r: {rr}" for rec, rr in zip(self.history, self.retrieved, strict=False) if rr)
                 size = (self.config.image_size, self.config.image_size)
@@ -252,7 +269,8 @@ class MllmLearner(_StopLearner):
         assert isinstance(h, StopAnswer)
         self._evidence = None
         if trajectories and not h.new_scene:
-            self._evidence = (prompt_h(trajectories[0], h, record.estimate.goals[0], self.config.epsilon), trajectories[0])
+            ph = prompt_h(trajectories[0], h, record.estimate.goals[0], self.config.epsilon, self.config.early_threshold)
+            self._evidence = (ph, trajectories[0])
         self.history.append(record)
         self.retrieved.append(None)
         self.notes.clear()

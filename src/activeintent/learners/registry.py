@@ -25,6 +25,8 @@ class LearnerContext:
     design_scenes: bool = True
     epsilon: float = 2.0
     prior: str = "length"
+    variant: str = "faithful"  # the paper's methods: faithful (as the paper ran them) | structured
+    early_threshold: float | None = None  # eq. 3: a stop before this many seconds shows no I_b (None: ε)
 
 
 @dataclass
@@ -59,23 +61,34 @@ def _bayes(signal: str, kind: str = "eig") -> Callable[[LearnerContext], Learner
     return build
 
 
+VARIANTS = ("faithful", "structured")
+
+
 def _paper(kind: str) -> Callable[[LearnerContext], Learner]:
     def build(ctx: LearnerContext) -> Learner:
-        from activeintent.learners.paper import (
-            MllmLearner,
-            MllmLlmLearner,
-            PaperLearnerConfig,
-            PreferenceLearner,
-        )
-
-        config = PaperLearnerConfig(design_scenes=ctx.design_scenes, epsilon=ctx.epsilon)
-        if kind == "preference":
-            return PreferenceLearner(ctx.llm, config)  # type: ignore[arg-type]
-        if kind == "mllm":
-            return MllmLearner(ctx.vlm or ctx.llm, config)  # type: ignore[arg-type]
-        if ctx.retriever not in ("vision", "symbolic"):
+        if ctx.variant not in VARIANTS:
+            raise ValueError(f"Unknown variant {ctx.variant!r}; valid variants: {', '.join(VARIANTS)}.")
+        if kind == "mllm-llm" and ctx.retriever not in ("vision", "symbolic"):
             raise ValueError(f"Unknown retriever {ctx.retriever!r}; valid retrievers: vision, symbolic.")
-        return MllmLlmLearner(ctx.llm, ctx.vlm, retriever=ctx.retriever, config=config)  # type: ignore[arg-type]
+        if ctx.variant == "faithful":
+            from activeintent.learners import faithful as f
+
+            cfg = f.FaithfulConfig(design_scenes=ctx.design_scenes, epsilon=ctx.epsilon,
+                                   early_threshold=ctx.early_threshold, seed=ctx.seed)
+            if kind == "preference":
+                return f.FaithfulPreferenceLearner(ctx.llm, cfg)  # type: ignore[arg-type]
+            if kind == "mllm":
+                return f.FaithfulMllmLearner(ctx.vlm or ctx.llm, cfg)  # type: ignore[arg-type]
+            return f.FaithfulMllmLlmLearner(ctx.llm, ctx.vlm, retriever=ctx.retriever, config=cfg)  # type: ignore[arg-type]
+        from activeintent.learners import paper as p
+
+        config = p.PaperLearnerConfig(design_scenes=ctx.design_scenes, epsilon=ctx.epsilon,
+                                      early_threshold=ctx.early_threshold)
+        if kind == "preference":
+            return p.PreferenceLearner(ctx.llm, config)  # type: ignore[arg-type]
+        if kind == "mllm":
+            return p.MllmLearner(ctx.vlm or ctx.llm, config)  # type: ignore[arg-type]
+        return p.MllmLlmLearner(ctx.llm, ctx.vlm, retriever=ctx.retriever, config=config)  # type: ignore[arg-type]
 
     return build
 
@@ -134,5 +147,5 @@ def make_learner(name: str, ctx: LearnerContext) -> Learner:
     return get_method(name)(ctx)
 
 
-__all__ = ["BASELINES", "METHODS", "PAPER_METHODS", "LearnerContext", "Method", "UnknownName",
+__all__ = ["BASELINES", "METHODS", "PAPER_METHODS", "VARIANTS", "LearnerContext", "Method", "UnknownName",
            "check_method", "get_method", "make_learner", "method_names"]

@@ -5,8 +5,14 @@ prompt(h) = x_n                          if h = None   (watched to the end)
           = {I_0, x_b, I_b, x_s, I_s}    otherwise
 
 The ``vision`` retriever shows the images to a multimodal model p_ψ; the ``symbolic``
-retriever describes the same moments from the trajectory log (relations in I_0, I_b, I_s and
-the skill being executed at the stop), for text-only models.
+retriever describes the same moments from the trajectory log, for text-only models. In the
+``structured`` variant it also names the skill being executed at the stop; in the ``faithful``
+variant (:func:`faithful_prompt_h`, :func:`describe_view`, :func:`faithful_symbolic_retrieval`)
+a stop carries only its time and what the pictures show — where the objects are and which block
+the robot is holding — never which step of the plan was running.
+
+Two numbers, as in the original code: ``epsilon`` (ε) is how long before the stop I_b is taken,
+``early`` the stop time below which no I_b is shown (the paper's "h < ε" writes both as ε).
 """
 
 from __future__ import annotations
@@ -17,7 +23,7 @@ from typing import Literal
 from activeintent.learners import prompts
 from activeintent.llm.base import ImagePart, Message, TextPart
 from activeintent.signals.stop import StopAnswer
-from activeintent.world import describe_skill, describe_state, relations
+from activeintent.world import WorldState, describe_skill, describe_state, relations
 from activeintent.world.trajectory import Trajectory
 
 RetrieverName = Literal["vision", "symbolic"]
@@ -46,8 +52,12 @@ class PromptH:
         return [m.label for m in self.moments]
 
 
-def prompt_h(traj: Trajectory, h: StopAnswer, goal: str, epsilon: float) -> PromptH:
-    """Build prompt(h) exactly as eq. 3 (ε in seconds)."""
+def prompt_h(traj: Trajectory, h: StopAnswer, goal: str, epsilon: float, early: float | None = None) -> PromptH:
+    """Build prompt(h) as eq. 3 for the ``structured`` variant: I_b is ε seconds before the stop,
+    shown when the stop came at ``early`` seconds or later (default: ε, the paper's h < ε).
+    x_s names the skill being executed at the stop (see :func:`faithful_prompt_h` for the
+    paper's prompt, which carries only the time and the images)."""
+    early = epsilon if early is None else early
     x = prompts.sections("eq3_prompt_h")
     if h.stop_time is None:
         return PromptH("none", prompts.Template(x["x_n"]).substitute(goal=goal))
@@ -57,10 +67,10 @@ def prompt_h(traj: Trajectory, h: StopAnswer, goal: str, epsilon: float) -> Prom
     xs = prompts.Template(x["x_s"]).substitute(stop_time=f"{h.stop_time:.1f}", skill=skill)
     i0 = Moment("I_0", "", 0.0)
     i_s = Moment("I_s", xs, h.stop_time)
-    if h.stop_time < epsilon:
+    if h.stop_time < early:
         return PromptH("early", x0, [i0, i_s])
     xb = prompts.Template(x["x_b"]).substitute(epsilon=f"{epsilon:g}")
-    return PromptH("late", x0, [i0, Moment("I_b", xb, h.stop_time - epsilon), i_s])
+    return PromptH("late", x0, [i0, Moment("I_b", xb, max(0.0, h.stop_time - epsilon)), i_s])
 
 
 def as_images(ph: PromptH, traj: Trajectory, size: tuple[int, int] = (240, 240)) -> list[TextPart | ImagePart]:
@@ -115,3 +125,81 @@ def vision_messages(
     head = prompts.render("eq4_retrieve", task=prompts.render("x_task"), prompt_h="The scene images follow.",
                           history=history or "none")
     return [Message(role="user", content=[TextPart(text=head), *as_images(ph, traj, size)])]
+
+
+# -- the faithful variant: only the time of the stop and what the pictures show --------------------
+
+
+def _held(state: WorldState, rel) -> list[str]:
+    return [b for b in state.blocks if b not in rel.on_table and not rel.in_bowl(b) and not rel.below(b)]
+
+
+def describe_view(state: WorldState) -> str:
+    """What a picture of ``state`` shows, in words: where the objects are, and a block the robot
+    is holding in the air (a block neither on the table, nor in a bowl, nor on another block)."""
+    rel = relations(state)
+    text = describe_state(state, rel)
+    held = _held(state, rel)
+    if held:
+        text += " " + " ".join(f"The robot is holding the {b} in the air above the {rel.table_position[b]}." for b in held)
+    return text
+
+
+def faithful_prompt_h(traj: Trajectory, h: StopAnswer, goal: str, epsilon: float, early: float) -> PromptH:
+    """prompt(h) of eq. 3 in the paper's terms: x_n when there was no stop (or nothing moved);
+    {I_0, x_s, I_s} when the stop came before ``early`` seconds; else {I_0, x_b, I_b, x_s, I_s}
+    with I_b taken ``epsilon`` seconds before the stop. x_s says only when the stop came."""
+    x = prompts.sections("faithful_eq3")
+    if h.stop_time is None:
+        key = "x_n" if traj.moved_anything else "x_nothing"
+        return PromptH("none", prompts.Template(x[key]).substitute(goal=goal))
+    x0 = prompts.Template(x["x_0"]).substitute(goal=goal)
+    i0 = Moment("I_0", "", 0.0)
+    i_s = Moment("I_s", prompts.Template(x["x_s"]).substitute(stop_time=f"{h.stop_time:.1f}"), h.stop_time)
+    if h.stop_time < early:
+        return PromptH("early", x0, [i0, i_s])
+    xb = prompts.Template(x["x_b"]).substitute(epsilon=f"{epsilon:g}")
+    return PromptH("late", x0, [i0, Moment("I_b", xb, max(0.0, h.stop_time - epsilon)), i_s])
+
+
+def as_view_text(ph: PromptH, traj: Trajectory) -> str:
+    """prompt(h) for a text-only model: each picture replaced by :func:`describe_view`."""
+    lines = [ph.text]
+    for m in ph.moments:
+        if m.caption:
+            lines.append(m.caption)
+        lines.append(f"[picture {m.label}] {describe_view(traj.state_at(m.t))}")
+    return "\n".join(lines)
+
+
+def _changes(before: WorldState, after: WorldState) -> list[str]:
+    first, last = relations(before), relations(after)
+    out = []
+    for name, rel in (("in", "inside"), ("on", "on"), ("next to", "next_to")):
+        was = {tuple(p) for p in getattr(first, rel)}
+        now = {tuple(p) for p in getattr(last, rel)}
+        out += [f"the {a} is now {name} the {b}" for a, b in sorted(now - was)]
+        out += [f"the {a} is no longer {name} the {b}" for a, b in sorted(was - now)]
+    held_before, held_now = _held(before, first), _held(after, last)
+    out += [f"the robot has picked up the {b}" for b in held_now if b not in held_before]
+    return out
+
+
+def faithful_symbolic_retrieval(ph: PromptH, traj: Trajectory, h: StopAnswer) -> str:
+    """r for text-only models, from the pictures of prompt(h) only (I_0, I_b, I_s): what
+    changed between them and what the last one shows. No plan step, no skill name."""
+    if h.stop_time is None:
+        if not traj.moved_anything:
+            return "The robot could not carry out the goal, so nothing moved; the person had nothing to judge."
+        return f"The person watched the whole execution without stopping it. The table at the end: {describe_view(traj.outcome)}"
+    at_stop = traj.state_at(h.stop_time)
+    text = f"The person pressed stop at t = {h.stop_time:.1f} s."
+    before = next((m for m in ph.moments if m.label == "I_b"), None)
+    if before is not None:
+        recent = _changes(traj.state_at(before.t), at_stop)
+        text += (f" In the {h.stop_time - before.t:g} s before the stop: {'; '.join(recent)}." if recent
+                 else f" Nothing visibly changed in the {h.stop_time - before.t:g} s before the stop.")
+    since = _changes(traj.state_at(0.0), at_stop)
+    if since:
+        text += f" Since the start: {'; '.join(since)}."
+    return text + f" The table at the stop: {describe_view(at_stop)}"

@@ -1,8 +1,12 @@
 """Structured model outputs (pydantic). Goal schemas are built per scene.
 
-A goal y must be written in the canonical phrasing the `parse` executor reads; the schema
-carries that as a regular expression over the scene's objects, so grammar-constrained models
-(the embedded default) can only produce executable goals and remote models get a repair round.
+``structured`` variant: a goal y must be written in the canonical phrasing the `parse`
+executor reads; the schema carries that as a regular expression over the scene's objects, so
+grammar-constrained models (the embedded default) can only produce executable goals and
+remote models get a repair round.
+
+``faithful`` variant (the paper's): z and y are free text, written after the model's own
+reasoning (the first field); y goes to the instruction-to-action module as it is.
 """
 
 from __future__ import annotations
@@ -65,3 +69,41 @@ def scene_schema() -> type[BaseModel]:
     """The learner's choice of 3–5 objects for the next scene."""
     Obj = Literal[tuple(ALL_OBJECTS)]  # type: ignore[valid-type]
     return create_model("SceneChoice", objects=(list[Obj], Field(min_length=3, max_length=5)))  # type: ignore[call-overload]
+
+
+# -- the faithful variant: free-form z and y, the model's reasoning first --------------------------
+# Field order is the order a grammar-constrained model writes them in: reasoning, then z, then y.
+
+def _reasoning():
+    return Field(min_length=1, max_length=1200, description="your reasoning, before the answer")
+
+
+def faithful_answer_schema(n_goals: int, with_done: bool = False) -> type[BaseModel]:
+    """The answer of one round (eq. 1–2 or 5–6) or of a test scene: reasoning, z, y (free text)."""
+    fields: dict = {
+        "reasoning": (str, _reasoning()),
+        "preference": (str, Field(min_length=1, max_length=300, description="the person's preference z, as you now see it")),
+    }
+    if n_goals == 1:
+        fields["goal"] = (str, Field(min_length=1, max_length=400, description="the goal y for the robot, one sentence"))
+    else:
+        fields["goal_a"] = (str, Field(min_length=1, max_length=400, description="goal A, one sentence"))
+        fields["goal_b"] = (str, Field(min_length=1, max_length=400, description="goal B, one sentence"))
+    if with_done:
+        fields["done"] = (bool, Field(description="true only when you are sure of the preference"))
+    name = "FaithfulAnswer" if n_goals == 1 else "FaithfulPairAnswer"
+    return create_model(name, **fields)  # type: ignore[call-overload]
+
+
+class FaithfulRetrieval(BaseModel):
+    """r (eq. 4): what the pictures around a stop show about the person's objection."""
+
+    reasoning: str = _reasoning()
+    retrieved: str = Field(min_length=1, max_length=600, description="at most three sentences")
+
+
+def faithful_scene_schema() -> type[BaseModel]:
+    """The learner's choice of 3–5 objects, with its reasoning first."""
+    Obj = Literal[tuple(ALL_OBJECTS)]  # type: ignore[valid-type]
+    return create_model("FaithfulScene", reasoning=(str, _reasoning()),  # type: ignore[call-overload]
+                        objects=(list[Obj], Field(min_length=3, max_length=5)))

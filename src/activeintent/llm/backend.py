@@ -153,9 +153,11 @@ class BackendModel(ChatModel):
         temperature: float = 0.0,
         max_tokens: int = 512,
         prompt_version: str = "",
+        seed: int | None = None,
     ) -> str:
         request = ChatRequest(
-            messages=messages, temperature=temperature, max_tokens=max_tokens, seed=self.backend.seed
+            messages=messages, temperature=temperature, max_tokens=max_tokens,
+            seed=self.backend.seed if seed is None else seed,
         )
         return self._call(request, "chat", prompt_version).text
 
@@ -167,6 +169,7 @@ class BackendModel(ChatModel):
         temperature: float = 0.0,
         max_tokens: int = 512,
         prompt_version: str = "",
+        seed: int | None = None,
     ) -> T:
         json_schema = schema.model_json_schema()
         conversation = list(messages)
@@ -176,7 +179,7 @@ class BackendModel(ChatModel):
                 messages=conversation,
                 temperature=temperature,
                 max_tokens=max_tokens,
-                seed=self.backend.seed,
+                seed=self.backend.seed if seed is None else seed,
                 json_schema=json_schema,
                 schema_name=schema.__name__,
             )

@@ -99,8 +99,10 @@ class ChatModel(ABC):
         temperature: float = 0.0,
         max_tokens: int = 512,
         prompt_version: str = "",
+        seed: int | None = None,
     ) -> str:
-        """Free-text completion."""
+        """Free-text completion. ``seed`` (default: the backend's) picks the draw when sampling
+        at temperature > 0; it is part of the request, so of the cache key."""
 
     @abstractmethod
     def structured(
@@ -111,6 +113,7 @@ class ChatModel(ABC):
         temperature: float = 0.0,
         max_tokens: int = 512,
         prompt_version: str = "",
+        seed: int | None = None,
     ) -> T:
         """A validated instance of ``schema`` (repaired or raised as ModelError, never malformed)."""
 
