@@ -21,7 +21,32 @@ def test_bad_options_fail_before_serving_and_list_the_valid_ones(tmp_path):
     assert "bayes-preference" in res.output and "mllm-llm" in res.output
     res = runner.invoke(app, ["serve", "--method", "bayes-stop", "--intention", "nonsense", "--out", str(tmp_path)])
     assert res.exit_code != 0 and "color-match" in res.output
+    res = runner.invoke(app, ["serve", "--method", "bayes-stop", "--show-estimate", "sometimes", "--out", str(tmp_path)])
+    assert res.exit_code != 0 and "after-answer" in res.output
     assert not any(tmp_path.iterdir())  # nothing was started or saved
+
+
+def test_serve_names_the_design_and_configures_the_study(tmp_path, monkeypatch):
+    import uvicorn
+
+    served = []
+    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: served.append(app))
+    runner = CliRunner()
+    res = runner.invoke(app, ["serve", "--method", "bayes-stop", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    said = " ".join(res.output.split())  # the console wraps long lines
+    assert "free rule" in said and "not scored" in said and "color-match" not in said
+    free = served[-1].state.manager.config
+    assert free.design == "free-rule" and free.intention is None and free.show_estimate == "hidden"
+    assert free.video_size == (480, 480)
+    res = runner.invoke(app, ["serve", "--method", "bayes-preference", "--intention", "color-match",
+                              "--show-estimate", "after-answer", "--video-size", "360", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    said = " ".join(res.output.split())
+    assert "assigned rule color-match" in said and "Put each block in the bowl of the same colour." in said
+    assigned = served[-1].state.manager.config
+    assert assigned.design == "assigned-rule" and assigned.intention == "color-match"
+    assert assigned.show_estimate == "after-answer" and assigned.video_size == (360, 360)
 
 
 def test_serve_binds_loopback_and_answers(tmp_path):
@@ -31,7 +56,7 @@ def test_serve_binds_loopback_and_answers(tmp_path):
     out = tmp_path / "study"
     proc = subprocess.Popen(
         [sys.executable, "-m", "activeintent.cli", "serve", "--port", str(port), "--method", "bayes-stop",
-         "--budget", "3", "--hide-estimate", "--out", str(out)],
+         "--budget", "3", "--show-estimate", "hidden", "--video-size", "128", "--out", str(out)],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )
     try:
@@ -43,8 +68,9 @@ def test_serve_binds_loopback_and_answers(tmp_path):
                 break
             except httpx.TransportError:
                 time.sleep(0.2)
-        assert config == {"method": "bayes-stop", "signal": "stop", "rounds": 3, "intention": None,
-                          "show_estimate": False, "fps": 10}
+        assert config == {"method": "bayes-stop", "signal": "stop", "rounds": 3, "design": "free-rule",
+                          "intention": None, "intention_description": None, "show_estimate": "hidden",
+                          "fps": 10, "video_size": [128, 128]}
         page = httpx.get(f"http://127.0.0.1:{port}/")
         assert page.status_code == 200 and "Teach the robot" in page.text
         listening = [c for c in _tcp_listeners() if c[1] == port]

@@ -62,7 +62,7 @@ def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server)
     state = waiting_state(srv.url, sid, 1)
     assert state["signal"] == "preference" and state["rounds"] == 2 and state["progress"] == 1
     assert [v["label"] for v in state["question"]["videos"]] == ["A", "B"]
-    assert state["estimate"]  # the study shows z by default
+    assert state["estimate"] is None  # hidden by default, and never before the first answer
     for v in state["question"]["videos"]:
         res = httpx.get(srv.url + v["url"])
         assert res.status_code == 200 and res.headers["content-type"] == "video/webm"
@@ -194,6 +194,7 @@ def test_unknown_sessions_path_traversal_and_isolation(live_server):
             ("POST", f"/sessions/{sid}/answer", {"kind": "preference", "round": 1, "choice": "A"}),
             ("POST", f"/sessions/{sid}/events", {"events": [{"type": "x", "client_ts": 1}]}),
             ("GET", f"/sessions/{sid}/result", None),
+            ("POST", f"/sessions/{sid}/questionnaire", {"final_attempt": "yes", "rule": "mine"}),
         ]:
             res = httpx.request(method, api + path, json=body)
             assert res.status_code == 404, (method, path, res.text)
@@ -208,6 +209,7 @@ def test_unknown_sessions_path_traversal_and_isolation(live_server):
         f"/api/sessions/{a}/files/summary.json",
         f"/api/sessions/{a}/files/events.jsonl",
         f"/api/sessions/{a}/files/session.json",
+        f"/api/sessions/{a}/files/questionnaire.json",
         f"/api/sessions/{a}/files/../{b}/round1_a.webm",
         f"/api/sessions/{a}/files/..%2F{b}%2Fround1_a.webm",
         f"/api/sessions/{a}/files/%2e%2e%2f{b}%2fround1_a.webm",
@@ -246,11 +248,12 @@ def test_openapi_describes_the_api(live_server):
     spec = httpx.get(f"{srv.url}/openapi.json").json()
     paths = set(spec["paths"])
     assert {"/api/config", "/api/sessions", "/api/sessions/{sid}", "/api/sessions/{sid}/answer",
-            "/api/sessions/{sid}/events", "/api/sessions/{sid}/result",
+            "/api/sessions/{sid}/events", "/api/sessions/{sid}/result", "/api/sessions/{sid}/questionnaire",
             "/api/sessions/{sid}/files/{name}"} <= paths
     config = httpx.get(f"{srv.url}/api/config").json()
-    assert config == {"method": "bayes-stop", "signal": "stop", "rounds": 1, "intention": None,
-                      "show_estimate": True, "fps": 10}
+    assert config == {"method": "bayes-stop", "signal": "stop", "rounds": 1, "design": "free-rule",
+                      "intention": None, "intention_description": None, "show_estimate": "hidden", "fps": 10,
+                      "video_size": [480, 480]}
 
 
 def test_stopping_the_server_cancels_sessions_in_progress(live_server):

@@ -7,6 +7,7 @@ ACTIVEINTENT_UPDATE_SCREENSHOTS=1 they are also copied to docs/img/webapp-*.png.
 
 from __future__ import annotations
 
+import csv
 import json
 import math
 import os
@@ -15,11 +16,16 @@ from pathlib import Path
 from urllib.parse import parse_qs, urlsplit
 
 import pytest
+from typer.testing import CliRunner
 
+from activeintent.cli import app
 from activeintent.records import read_rounds
 from activeintent.sim.env import SimConfig
 
 DOCS_IMG = Path(__file__).resolve().parents[2] / "docs" / "img"
+UPDATING = os.environ.get("ACTIVEINTENT_UPDATE_SCREENSHOTS") == "1"
+# small videos keep the tests quick; the documentation's screenshots show the study's default
+VIDEO = {} if UPDATING else {"video_size": (240, 240)}
 
 pytestmark = pytest.mark.slow  # a browser and whole episodes
 
@@ -28,7 +34,7 @@ def shot(page, tmp_path: Path, name: str) -> Path:
     path = tmp_path / f"webapp-{name}.png"
     page.screenshot(path=str(path), full_page=True)
     assert path.stat().st_size > 10_000 and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    if os.environ.get("ACTIVEINTENT_UPDATE_SCREENSHOTS") == "1":
+    if UPDATING:
         DOCS_IMG.mkdir(parents=True, exist_ok=True)
         shutil.copy(path, DOCS_IMG / path.name)
     return path
@@ -64,14 +70,14 @@ def start(page, url: str, participant: str, tmp_path: Path | None = None) -> str
 
 
 def test_two_round_preference_session(live_server, page, tmp_path):
-    srv = live_server("bayes-preference", rounds=2, seed=3)
+    srv = live_server("bayes-preference", rounds=2, seed=3, **VIDEO)
     sid = start(page, srv.url, "P-pref", tmp_path)
     assert urlsplit(page.url).path == "/preference"
 
     wait_round(page, 1)
     wait_videos(page, "video-a", "video-b")
     assert page.inner_text("#progress .label") == "Round 1 of 2"
-    assert page.is_visible("#estimate")  # z is shown (the study's default)
+    assert not page.is_visible("#estimate")  # the guess is hidden (the study's default)
     for v in ("video-a", "video-b"):  # autoplaying, looping videos
         assert page.evaluate(f"document.getElementById('{v}').loop")
     page.wait_for_function("document.getElementById('video-a').currentTime > 0")
@@ -85,8 +91,9 @@ def test_two_round_preference_session(live_server, page, tmp_path):
     page.wait_for_url("**/done?session=*")
     page.wait_for_selector("#question:not(.hidden)")
     wait_videos(page, "final")
+    page.wait_for_selector("#questionnaire:visible")
     shot(page, tmp_path, "thank-you")
-    assert "Thank you" in page.inner_text("#thanks")
+    assert page.is_visible("#q-final") and page.is_visible("#q-rule")
 
     session = srv.manager.get(sid)
     assert session.join(120) and session.status == "finished", session.error
@@ -110,7 +117,7 @@ def test_two_round_preference_session(live_server, page, tmp_path):
 
 
 def test_clicker_session_stops_at_a_known_moment(live_server, page, tmp_path):
-    srv = live_server("bayes-stop", rounds=2, seed=4)
+    srv = live_server("bayes-stop", rounds=2, seed=4, **VIDEO)
     sid = start(page, srv.url, "P-stop")
     assert urlsplit(page.url).path == "/clicker"
     folder = srv.session_dir(sid)
@@ -140,6 +147,7 @@ def test_clicker_session_stops_at_a_known_moment(live_server, page, tmp_path):
     page.keyboard.press("Space")  # the Stop shortcut
 
     wait_round(page, 2)
+    wait_videos(page, "video")
     assert page.is_disabled("#good")  # not before the video has ended
     page.evaluate(
         "() => { const v = document.getElementById('video'); v.currentTime = Math.max(0, v.duration - 0.3); v.play(); }"
@@ -166,3 +174,129 @@ def test_clicker_session_stops_at_a_known_moment(live_server, page, tmp_path):
     assert [e["data"]["via"] for e in log if e["type"] == "looks_good"] == ["click"]
     answers = [e for e in log if e["type"] == "answer" and e["source"] == "server"]
     assert [a["answer"] for a in answers] == [h1, h2]
+
+
+def export(out: Path, to: Path) -> list[dict]:
+    res = CliRunner().invoke(app, ["study-export", str(out), "--to", str(to)])
+    assert res.exit_code == 0, res.output
+    if to.suffix == ".jsonl":
+        return [json.loads(line) for line in to.read_text().splitlines()]
+    return list(csv.DictReader(to.open(newline="")))
+
+
+def answer_questionnaire(page, final_attempt: str, rule: str, comments: str) -> None:
+    page.wait_for_selector("#questionnaire:visible")
+    page.click("#q-submit")  # nothing chosen yet: the page asks first and sends nothing
+    assert "Please answer" in page.inner_text("#q-status")
+    page.get_by_role("radio", name=final_attempt.capitalize(), exact=True).check()
+    page.fill("#q-rule", rule)
+    page.fill("#q-comments", comments)
+    page.get_by_role("button", name="Send my answers").click()
+    page.wait_for_selector("#finished:visible")
+    assert not page.is_visible("#questionnaire")
+
+
+def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server, page, tmp_path):
+    small = {"video_size": (160, 160)}
+
+    # -- free rule: each participant picks a rule; the guess stays hidden; nothing is scored ----
+    free = live_server("bayes-preference", rounds=1, seed=5, **small)
+    page.goto(free.url + "/")
+    page.wait_for_selector("#start:enabled")
+    assert page.is_visible("#rule-free") and not page.is_visible("#rule-assigned")
+    page.fill("#participant", "P-free")
+    page.click("#start")
+    page.wait_for_url("**/preference?session=*")
+    sid = session_id(page)
+    wait_round(page, 1)
+    # controls are named by what they do; the key hints are outside the names
+    for name in ("A is better", "B is better", "Can't choose", "New scene"):
+        assert page.get_by_role("button", name=name, exact=True).count() == 1, name
+    assert page.evaluate("[...document.querySelectorAll('button kbd')].every(k => k.getAttribute('aria-hidden') === 'true')")
+    assert page.get_attribute("#video-a", "aria-label").startswith("Video A")
+    scene = free.manager.get(sid).state()["question"]["scene"]
+    assert all(name in page.text_content("#caption-a") for name in scene)
+    assert not page.is_visible("#estimate")
+    assert not page.is_visible("#legend")
+    page.get_by_role("button", name="Show colour names").click()
+    assert page.is_visible("#legend") and page.get_attribute("#legend-toggle", "aria-expanded") == "true"
+    assert page.locator("#legend-list li").all_inner_texts() == scene
+    page.keyboard.press("b")
+
+    page.wait_for_url("**/done?session=*")
+    page.wait_for_selector("#question:not(.hidden)")
+    assert page.is_visible("#q-final")
+    assert page.is_visible("#legend")  # colour names stay on once asked for
+    answer_questionnaire(page, "partly", "Warm colours to the left", "The videos were clear.")
+    assert not page.is_visible("#estimate")  # hidden study: not even the final guess
+    summary = json.loads((free.session_dir(sid) / "summary.json").read_text())
+    assert summary["success"] is None and summary["success_basis"] == "none" and summary["intention"] is None
+    (row,) = export(free.out, tmp_path / "free.csv")
+    assert row["session"] == sid and row["participant"] == "P-free" and row["design"] == "free-rule"
+    assert row["success"] == "" and row["success_basis"] == "none" and row["intention"] == ""
+    assert row["round1_answer"] == "B" and row["status"] == "finished"
+    assert row["questionnaire_final_attempt"] == "partly"
+    assert row["questionnaire_rule"] == "Warm colours to the left"
+    assert row["questionnaire_comments"] == "The videos were clear."
+
+    # -- assigned rule: told on the start page, guesses shown after each answer, stop kept ------
+    assigned = live_server("bayes-stop", rounds=2, seed=6, intention="color-match", show_estimate="after-answer",
+                           **small)
+    page.goto(assigned.url + "/")
+    page.wait_for_selector("#start:enabled")
+    assert page.is_visible("#rule-assigned") and not page.is_visible("#rule-free")
+    assert page.inner_text("#rule-text") == "Put each block in the bowl of the same colour."
+    page.fill("#participant", "P-assigned")
+    page.click("#start")
+    page.wait_for_url("**/clicker?session=*")
+    sid = session_id(page)
+    wait_round(page, 1)
+    assert not page.is_visible("#feedback") and not page.is_visible("#estimate")  # no guess in round 1
+    assert page.get_by_role("button", name="Stop the robot", exact=True).count() == 1
+    wait_videos(page, "video")
+    page.wait_for_function("document.getElementById('video').currentTime > 0.3")
+    # record what the page shows at the moment the stop is confirmed (before any later poll)
+    page.evaluate(
+        """() => {
+            const badge = document.getElementById('stop-badge');
+            new MutationObserver((_, obs) => {
+                if (badge.classList.contains('hidden')) return;
+                const v = document.getElementById('video');
+                window.atStop = {question: !document.getElementById('question').classList.contains('hidden'),
+                                 paused: v.paused, time: v.currentTime, src: v.currentSrc,
+                                 marker: !document.querySelector('#timeline .marker').classList.contains('hidden')};
+                obs.disconnect();
+            }).observe(badge, {attributes: true});
+        }"""
+    )
+    page.keyboard.press("Space")
+    page.wait_for_function("window.atStop !== undefined")
+    at_stop = page.evaluate("window.atStop")
+    assert at_stop["question"] and at_stop["paused"] and at_stop["marker"] and "round1_y" in at_stop["src"]
+
+    page.wait_for_selector("#feedback:visible")  # round 2 is ready: first the guess, then the video
+    assert not page.is_visible("#question")
+    assert page.inner_text("#feedback .guess")
+    assert "% sure" in page.inner_text("#feedback .confidence")
+    page.get_by_role("button", name="Continue to round 2 of 2").click()
+    wait_round(page, 2)
+    assert not page.is_visible("#feedback") and not page.is_visible("#stop-badge")
+    page.keyboard.press("n")
+
+    page.wait_for_url("**/done?session=*")
+    page.wait_for_selector("#question:not(.hidden)")
+    assert page.inner_text("#q-rule-label").startswith("In your own words")
+    assert not page.is_visible("#estimate")  # not before the questionnaire is answered
+    answer_questionnaire(page, "yes", "Blocks into the bowl of their colour", "")
+    assert page.is_visible("#estimate") and page.inner_text("#estimate .guess")
+    session = assigned.manager.get(sid)
+    assert session.join(60) and session.status == "finished", session.error
+    (row,) = export(assigned.out, tmp_path / "assigned.jsonl")
+    summary = json.loads((assigned.session_dir(sid) / "summary.json").read_text())
+    assert row["design"] == "assigned-rule" and row["intention"] == "color-match"
+    assert summary["success_basis"] == "assigned-rule" and row["success"] == summary["success"]
+    assert [r["answer"] for r in row["rounds"]] == ["stop", "new_scene"]
+    assert row["rounds"][0]["stop_time"] == pytest.approx(at_stop["time"], abs=1e-3)
+    assert row["questionnaire_final_attempt"] == "yes"
+    assert row["questionnaire_rule"] == "Blocks into the bowl of their colour"
+    assert row["questionnaire_comments"] is None and row["show_estimate"] == "after-answer"

@@ -1,7 +1,9 @@
-"""`activeintent serve`: the human-in-the-loop web app."""
+"""`activeintent serve`: the human-in-the-loop web app; `activeintent study-export`: one
+table of a study's sessions."""
 
 from __future__ import annotations
 
+from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
@@ -11,8 +13,15 @@ from activeintent import options as opt
 from activeintent.options import D
 
 
+class ShowEstimate(StrEnum):
+    hidden = "hidden"
+    after_answer = "after-answer"
+    always = "always"
+
+
 def register(app: typer.Typer) -> None:
     app.command(name="serve")(serve)
+    app.command(name="study-export")(study_export)
 
 
 def serve(
@@ -20,11 +29,12 @@ def serve(
     port: Annotated[int, typer.Option("--port", min=0, max=65535, help="TCP port")] = 8000,
     method: Annotated[str, typer.Option("--method", help="preference | mllm | mllm-llm | bayes-preference | bayes-stop")] = "bayes-preference",
     rounds: opt.Budget = D.budget,
-    intention: opt.Intention = None,
-    intention_file: opt.IntentionFile = None,
+    intention: Annotated[str | None, typer.Option("--intention", help="Assign this rule to every participant (shown on the start page; success is scored against it). Without it each participant picks their own rule and success is not scored (free-rule design)")] = None,
+    intention_file: Annotated[str | None, typer.Option("--intention-file", help="Assign your own rule: path.py:NAME (as --intention)")] = None,
     seed: Annotated[int, typer.Option("--seed", help="Session n runs with seed + n")] = 0,
     out: Annotated[Path, typer.Option("--out", help="Sessions are saved in OUT/<session-id>/")] = Path("runs/web"),
-    show_estimate: Annotated[bool, typer.Option("--show-estimate/--hide-estimate", help="Show the learner's current estimate z to the participant")] = True,
+    show_estimate: Annotated[ShowEstimate, typer.Option("--show-estimate", help="The learner's current guess: never shown (hidden), shown between rounds after each answer (after-answer), or above the videos from round 2 on (always); never before the first answer")] = ShowEstimate.hidden,
+    video_size: Annotated[int, typer.Option("--video-size", min=64, max=1024, help="Width and height of the videos in pixels (larger takes longer to render before each round)")] = 480,
     llm: opt.Llm = D.llm,
     vlm: opt.Vlm = None,
     base_url: opt.BaseUrl = None,
@@ -56,18 +66,21 @@ def serve(
     from activeintent.web.server import create_app, runner_builder
     from activeintent.web.session import StudyConfig
 
-    extra = dict(intention_file=intention_file, llm=llm, vlm=vlm, base_url=base_url, cache=cache,
+    extra = dict(llm=llm, vlm=vlm, base_url=base_url, cache=cache,
                  cache_mode=cache_mode, executor=executor, retriever=retriever, plugins=list(plugin or []))
     try:
-        # options and the hidden intention are checked now so a typo fails before anyone opens the page
-        check_options(opt.run_options(method=method, budget=rounds, intention=intention, **extra))
-        resolve_intention(intention or (None if intention_file else "color-match"), intention_file)
+        # options and the assigned rule are checked now so a typo fails before anyone opens the page
+        check_options(opt.run_options(method=method, budget=rounds, intention=intention,
+                                      intention_file=intention_file, **extra))
+        rule = resolve_intention(intention, intention_file) if intention or intention_file else None
         signal = get_method(method).signal
     except (ValueError, IntentionError, FileNotFoundError) as err:
         raise typer.BadParameter(str(err)) from None
-    config = StudyConfig(method=method, signal=signal, rounds=rounds, intention=intention,
-                         show_estimate=show_estimate, out_dir=out, seed=seed,
-                         answer_timeout=answer_timeout, max_sessions=max_sessions)
+    config = StudyConfig(method=method, signal=signal, rounds=rounds,
+                         intention=rule.name if rule else None, intention_file=intention_file,
+                         intention_description=(rule.description or rule.name) if rule else None,
+                         show_estimate=show_estimate.value, video_size=(video_size, video_size), out_dir=out,
+                         seed=seed, answer_timeout=answer_timeout, max_sessions=max_sessions)
     limits = Limits(max_sessions_per_client=max_sessions_per_client,
                     max_new_sessions_per_hour=max_new_sessions_per_hour, idle_timeout=idle_timeout * 60,
                     max_body_bytes=max_request_kb * 1024, events_quota_bytes=int(events_quota_mb * 2**20))
@@ -76,7 +89,37 @@ def serve(
     shown = "localhost" if host in ("127.0.0.1", "::1") else host
     console.print(f"[bold]activeintent study[/]: {method} ({signal} signal), {rounds} rounds; "
                   f"sessions saved in {out}/")
+    if rule is not None:
+        console.print(f"Design: assigned rule [bold]{rule.name}[/] — participants are told "
+                      f"\"{config.intention_description}\"; success is scored against it.")
+    else:
+        console.print("Design: free rule — each participant picks their own rule; success is not scored "
+                      "(their own verdict is in the questionnaire).")
+    console.print(f"The learner's guess: {config.show_estimate}; videos {video_size}×{video_size} px.")
     console.print(f"Open http://{shown}:{port}/ — API schema at /openapi.json. Ctrl-C stops.")
     if host not in ("127.0.0.1", "localhost", "::1"):
         console.print(f"[yellow]Listening on {host}: anyone who can reach this address can take part.[/]")
     uvicorn.run(app, host=host, port=port, log_level="warning")
+
+
+def study_export(
+    out_dir: Annotated[Path, typer.Argument(help="The --out folder of `activeintent serve` (one sub-folder per session)")],
+    to: Annotated[Path, typer.Option("--to", help="The table to write: FILE.csv (one row per session) or FILE.jsonl (one object per session)")],
+) -> None:
+    """One table of a study: per session the participant code, design, rule, answers per round,
+    timings, success (assigned-rule sessions only) and the questionnaire."""
+    from rich.console import Console
+
+    from activeintent.web.export import collect_sessions, write_table
+
+    if not out_dir.is_dir():
+        raise typer.BadParameter(f"{out_dir} is not a folder", param_hint="OUT_DIR")
+    if to.suffix.lower() not in (".csv", ".jsonl"):
+        raise typer.BadParameter(f"{to.name}: the table is written as .csv or .jsonl", param_hint="--to")
+    sessions, skipped = collect_sessions(out_dir)
+    write_table(sessions, to)
+    console = Console(stderr=True)
+    for folder, why in skipped:
+        console.print(f"[yellow]skipped {folder.name}[/]: {why}")
+    answered = sum(1 for s in sessions if s["questionnaire_submitted"] is not None)
+    Console().print(f"{len(sessions)} sessions ({answered} with a questionnaire) written to {to}")

@@ -1,9 +1,10 @@
 """The human-in-the-loop web app: a JSON API under /api and plain HTML/JS pages.
 
 Pages: ``/`` (start), ``/preference`` (two videos, A / B / Can't choose / New scene),
-``/clicker`` (one video, Stop / Looks good / New scene) and ``/done`` (final execution and
-thank-you). Each page polls ``GET /api/sessions/{id}`` and answers with
-``POST /api/sessions/{id}/answer`` naming the round it answers.
+``/clicker`` (one video, Stop / Looks good / New scene) and ``/done`` (final execution, the
+end-of-session questionnaire and thank-you). Each page polls ``GET /api/sessions/{id}`` and
+answers with ``POST /api/sessions/{id}/answer`` naming the round it answers; the done page sends
+``POST /api/sessions/{id}/questionnaire``.
 """
 
 from __future__ import annotations
@@ -107,6 +108,44 @@ class EventBatch(_Body):
     events: list[ClientEvent] = Field(min_length=1, max_length=200)
 
 
+MAX_RULE_CHARS = 2000
+MAX_COMMENT_CHARS = 4000
+
+
+def _text(v: str | None, what: str) -> str | None:
+    """Free text as people type it: surrounding blanks dropped, line breaks and tabs kept, no
+    other control characters."""
+    if v is None:
+        return None
+    v = v.strip()
+    if any(not (c.isprintable() or c in "\n\t") for c in v):
+        raise ValueError(f"{what} takes printable characters, line breaks and tabs only")
+    return v
+
+
+class QuestionnaireAnswers(_Body):
+    final_attempt: Literal["yes", "partly", "no"] | None = Field(
+        None, description="did the robot's final attempt do what the participant wanted (required when "
+        "the session finished with a final attempt; left out otherwise)")
+    rule: str = Field(min_length=1, max_length=MAX_RULE_CHARS,
+                      description="the participant's rule in their own words")
+    comments: str | None = Field(None, max_length=MAX_COMMENT_CHARS, description="optional comments")
+    client_ts: float | None = _client_ts()
+
+    @field_validator("rule")
+    @classmethod
+    def _rule(cls, v: str) -> str:
+        v = _text(v, "rule") or ""
+        if not v:
+            raise ValueError("rule must say something: the participant's rule in their own words")
+        return v
+
+    @field_validator("comments")
+    @classmethod
+    def _comments(cls, v: str | None) -> str | None:
+        return _text(v, "comments") or None
+
+
 # -- the app ----------------------------------------------------------------------------------
 def _feedback_maker(session: WebSession, body: PreferenceAnswer | StopAnswer):
     if body.kind != session.config.signal:
@@ -179,13 +218,19 @@ def create_app(
 
     @app.get("/api/config", summary="The study's configuration (what every session runs)")
     def get_config() -> dict:
+        assigned = config.design == "assigned-rule"
         return {
             "method": config.method,
             "signal": config.signal,
             "rounds": config.rounds,
-            "intention": None,  # hidden from participants: it is what the learner must find
+            # assigned-rule: the rule participants are given (and are scored against);
+            # free-rule: every participant picks their own, nothing is scored
+            "design": config.design,
+            "intention": config.intention if assigned else None,
+            "intention_description": config.intention_description if assigned else None,
             "show_estimate": config.show_estimate,
             "fps": config.fps,
+            "video_size": list(config.video_size),
         }
 
     @app.post("/api/sessions", status_code=201, summary="Start a session (its episode starts at once)")
@@ -213,6 +258,13 @@ def create_app(
         with guard.events_quota(session, event_lines_size(events)):
             n = session.log_events(events)
         return {"logged": n}
+
+    @app.post("/api/sessions/{sid}/questionnaire", status_code=201,
+              summary="The end-of-session questionnaire (once, after the final attempt)")
+    def post_questionnaire(sid: str, body: QuestionnaireAnswers) -> dict:
+        session = session_or_404(sid)
+        record = session.submit_questionnaire(body.model_dump())
+        return {"saved": True, "questionnaire": record}
 
     @app.get("/api/sessions/{sid}/result", summary="The episode's result (summary.json) once finished")
     def get_result(sid: str) -> dict:
@@ -263,13 +315,17 @@ def _page(name: str):
 
 
 def runner_builder(config: StudyConfig, **options: Any) -> EpisodeBuilder:
-    """Sessions built by :func:`activeintent.runner.build_episode` (method, intention, rounds
-    from the study; ``options`` are further RunOptions fields, e.g. llm)."""
+    """Sessions built by :func:`activeintent.runner.build_episode` (method, assigned rule,
+    rounds from the study; ``options`` are further RunOptions fields, e.g. llm). A free-rule
+    study gives no intention: the runner's default stands in for the simulated parts and is
+    neither shown nor scored (see :func:`activeintent.web.session.study_summary`)."""
     # People watch physics; the session exports its own videos; the learner is scored on the
     # test scenes after the last answer only (no one waits for a curve).
     base = {"method": config.method, "budget": config.rounds, "env": "pybullet", "video": "none",
             "curve": False, **options}
-    if config.intention is not None:
+    if config.intention_file is not None:
+        base["intention_file"] = config.intention_file
+    elif config.intention is not None:
         base["intention"] = config.intention
 
     def build(seed: int, out_dir: Path, user, observers):

@@ -1,9 +1,14 @@
 // Clicker page: one video τ plays once; Stop records the media time of the frame on screen
 // (the server maps it to the trajectory tick); Looks good once it has ended; New scene.
+// After a stop the video stays paused on the frame the participant stopped at, with a marker,
+// until the next round is ready.
 "use strict";
 
 (() => {
   const video = document.getElementById("video");
+  const card = document.getElementById("video-card");
+  const badge = document.getElementById("stop-badge");
+  const timeline = document.getElementById("timeline");
   const stopBtn = document.getElementById("stop");
   const goodBtn = document.getElementById("good");
   const newBtn = document.getElementById("new-scene");
@@ -11,9 +16,18 @@
   const status = document.getElementById("status");
   let round = null; // the round on screen and not yet answered
   let shownRound = null;
+  let stoppedAt = null; // media time of the accepted stop, while its frame stays on screen
 
   Study.watchVideo(video, "robot", () => shownRound);
+  Study.setupLegend(document.getElementById("legend-toggle"), document.getElementById("legend"), () => shownRound);
 
+  function fraction(t) {
+    const d = video.duration;
+    return Number.isFinite(d) && d > 0 ? Math.min(1, Math.max(0, t / d)) : 0;
+  }
+  video.addEventListener("timeupdate", () => {
+    if (stoppedAt === null) timeline.querySelector(".played").style.width = `${100 * fraction(video.currentTime)}%`;
+  });
   video.addEventListener("ended", () => {
     if (round !== null) goodBtn.disabled = false;
   });
@@ -22,6 +36,25 @@
     playBtn.classList.add("hidden");
     video.play().catch(() => {});
   });
+
+  function markStop(t) {
+    stoppedAt = t;
+    card.classList.add("stopped");
+    badge.textContent = `Stopped here · ${t.toFixed(2)} s`;
+    badge.classList.remove("hidden");
+    const marker = timeline.querySelector(".marker");
+    marker.style.left = `${100 * fraction(t)}%`;
+    marker.classList.remove("hidden");
+    timeline.querySelector(".played").style.width = `${100 * fraction(t)}%`;
+  }
+
+  function clearStop() {
+    stoppedAt = null;
+    card.classList.remove("stopped");
+    badge.classList.add("hidden");
+    timeline.querySelector(".marker").classList.add("hidden");
+    timeline.querySelector(".played").style.width = "0%";
+  }
 
   function setEnabled(on) {
     stopBtn.disabled = !on;
@@ -44,8 +77,14 @@
     try {
       await Study.api("POST", `/api/sessions/${Study.sessionId}/answer`, body);
       Study.log("answer_accepted", { action, time: body.time ?? null }, answering);
-      status.textContent = action === "stop" ? `Stopped at ${body.time.toFixed(2)} s.` : "";
-      Study.setWaiting(true, "Thank you. The robot is thinking about what you showed it…");
+      if (action === "stop") {
+        markStop(body.time);
+        status.textContent = `You stopped the robot at ${body.time.toFixed(2)} s: the frame stays above.`;
+        Study.setWaiting(true, "Thank you. The robot is thinking about what you showed it…", true);
+      } else {
+        status.textContent = "";
+        Study.setWaiting(true, "Thank you. The robot is thinking about what you showed it…");
+      }
     } catch (err) {
       Study.log("answer_rejected", { action, error: err.message }, answering);
       status.textContent = `Not accepted: ${err.message}`;
@@ -63,6 +102,7 @@
     const k = e.key === " " ? "space" : e.key.toLowerCase();
     const action = { space: "stop", g: "looks_good", n: "new_scene" }[k];
     if (!action) return;
+    if (round === null && e.target && e.target.tagName === "BUTTON") return; // e.g. Continue, Show colour names
     e.preventDefault(); // space must not scroll or press a focused button
     Study.log("key", { key: k }, round);
     if (action === "looks_good" && goodBtn.disabled) return;
@@ -70,8 +110,10 @@
   });
 
   function show(q) {
-    shownRound = q.round;
     const v = q.videos[0];
+    clearStop();
+    Study.fillLegend(document.getElementById("legend-list"), q.legend);
+    Study.describeVideo(video, document.getElementById("caption"), "The robot tidying this table", q.legend, v.duration);
     playBtn.classList.add("hidden");
     video.src = v.url;
     video.load();
@@ -93,13 +135,14 @@
     Study.setProgress(s);
     Study.setEstimate(s);
     if (s.status === "waiting-for-answer" && s.question && s.question.round !== shownRound) {
-      show(s.question);
+      shownRound = s.question.round;
+      Study.betweenRounds(s, () => show(s.question));
     } else if (s.status === "waiting-for-learner") {
       round = null;
       setEnabled(false);
       Study.setWaiting(true, s.phase === "final"
         ? "Thank you! The robot is now trying what it learned on a new table…"
-        : "The robot is thinking about what you showed it…");
+        : "The robot is thinking about what you showed it…", stoppedAt !== null);
     }
   });
 })();

@@ -70,7 +70,7 @@ const Study = (() => {
     async function tick() {
       try {
         const s = await api("GET", `/api/sessions/${sessionId}`);
-        const key = `${s.status}|${s.question ? s.question.round : "-"}|${s.phase}|${s.estimate}`;
+        const key = `${s.status}|${s.question ? s.question.round : "-"}|${s.phase}|${JSON.stringify(s.estimate)}|${JSON.stringify(s.questionnaire)}`;
         if (key !== last) {
           last = key;
           onState(s);
@@ -89,22 +89,115 @@ const Study = (() => {
     if (!el) return;
     const done = s.status === "finished";
     el.querySelector(".label").textContent = done ? `Done (${s.rounds} of ${s.rounds})` : `Round ${s.progress} of ${s.rounds}`;
-    el.querySelector(".bar span").style.width = `${100 * (done ? 1 : (s.progress - 1) / s.rounds)}%`;
+    const bar = el.querySelector(".bar");
+    const finished = done ? s.rounds : s.progress - 1;
+    bar.querySelector("span").style.width = `${(100 * finished) / s.rounds}%`;
+    bar.setAttribute("aria-valuemax", String(s.rounds));
+    bar.setAttribute("aria-valuenow", String(finished));
+    bar.setAttribute("aria-valuetext", done ? "all rounds done" : `round ${s.progress} of ${s.rounds}`);
   }
 
+  // The learner's guess as one sentence plus its confidence, where the learner has one.
+  function fillGuess(box, est) {
+    box.querySelector(".guess").textContent = est ? est.z : "";
+    const conf = box.querySelector(".confidence");
+    if (!conf) return;
+    if (est && typeof est.confidence === "number") {
+      const pct = Math.round(100 * est.confidence);
+      conf.textContent = `The robot is ${pct}% sure of this guess (after ${est.answers} answer${est.answers === 1 ? "" : "s"}).`;
+      conf.title = est.basis || "";
+    } else {
+      conf.textContent = est ? "This robot does not say how sure it is." : "";
+    }
+  }
+
+  // The guess above the videos: only in studies that show it "always" (never in round 1:
+  // the server gives no guess before the first answer).
   function setEstimate(s) {
     const box = document.getElementById("estimate");
     if (!box) return;
-    box.classList.toggle("hidden", !s.estimate);
-    box.querySelector("span").textContent = s.estimate || "";
+    const show = Boolean(s.estimate) && s.show_estimate === "always";
+    box.classList.toggle("hidden", !show);
+    fillGuess(box, show ? s.estimate : null);
   }
 
-  function setWaiting(shown, text) {
+  // In "after-answer" studies the guess is shown between rounds: once the next round is ready,
+  // the page says what the robot now guesses, and the round starts when the participant goes on.
+  // The guess is never on screen while the participant decides.
+  function betweenRounds(s, proceed) {
+    const panel = document.getElementById("feedback");
+    if (!panel || s.show_estimate !== "after-answer" || !s.estimate || !s.question) {
+      if (panel) panel.classList.add("hidden");
+      proceed();
+      return;
+    }
+    const round = s.question.round;
+    fillGuess(panel, s.estimate);
+    document.getElementById("waiting").classList.remove("shown");
+    document.getElementById("question").classList.add("hidden");
+    panel.classList.remove("hidden");
+    const button = document.getElementById("continue");
+    button.textContent = `Continue to round ${s.progress} of ${s.rounds}`;
+    button.onclick = () => {
+      button.onclick = null;
+      panel.classList.add("hidden");
+      log("guess_continue", {}, round);
+      proceed();
+    };
+    button.focus();
+    log("guess_shown", { z: s.estimate.z, confidence: s.estimate.confidence, answers: s.estimate.answers }, round);
+  }
+
+  // keepQuestion: leave what is on screen (e.g. the frame the participant stopped at) visible.
+  function setWaiting(shown, text, keepQuestion = false) {
     const w = document.getElementById("waiting");
     const q = document.getElementById("question");
     if (text) w.querySelector("p").textContent = text;
     w.classList.toggle("shown", shown);
-    q.classList.toggle("hidden", shown);
+    w.classList.toggle("inline", shown && keepQuestion);
+    q.classList.toggle("hidden", shown && !keepQuestion);
+  }
+
+  // Colour names on request: a legend of the scene's objects next to the video. The choice is
+  // remembered for the next rounds and pages.
+  const LEGEND_KEY = "activeintent.colourNames";
+  function legendWanted() {
+    try { return localStorage.getItem(LEGEND_KEY) === "1"; } catch (_) { return false; }
+  }
+  function setupLegend(toggle, panel, roundOf) {
+    const apply = (on) => {
+      panel.classList.toggle("hidden", !on);
+      toggle.setAttribute("aria-expanded", String(on));
+      toggle.textContent = on ? "Hide colour names" : "Show colour names";
+    };
+    apply(legendWanted());
+    toggle.addEventListener("click", () => {
+      const on = panel.classList.contains("hidden");
+      try { localStorage.setItem(LEGEND_KEY, on ? "1" : "0"); } catch (_) { /* private mode */ }
+      apply(on);
+      log("colour_names", { shown: on }, roundOf ? roundOf() : null);
+    });
+  }
+  function fillLegend(list, legend) {
+    list.replaceChildren();
+    for (const item of legend || []) {
+      const li = document.createElement("li");
+      const swatch = document.createElement("span");
+      swatch.className = `swatch ${item.kind}`;
+      swatch.setAttribute("aria-hidden", "true");
+      if (item.hex) swatch.style.background = item.hex;
+      const name = document.createElement("span");
+      name.textContent = item.name;
+      li.append(swatch, name);
+      list.append(li);
+    }
+  }
+  // What a screen reader says about a video: its label and the objects on the table.
+  function describeVideo(video, captionEl, label, legend, seconds) {
+    video.setAttribute("aria-label", label);
+    const names = (legend || []).map((o) => o.name).join(", ");
+    const length = typeof seconds === "number" ? ` It lasts ${seconds.toFixed(1)} seconds and has no sound.` : "";
+    captionEl.textContent = `${label}.${length} Objects on the table: ${names || "none"}.`;
   }
 
   function showFatal(msg) {
@@ -135,5 +228,8 @@ const Study = (() => {
     return t && (t.tagName === "INPUT" || t.tagName === "TEXTAREA" || t.isContentEditable);
   }
 
-  return { sessionId, now, api, log, flush, goTo, poll, setProgress, setEstimate, setWaiting, showFatal, watchVideo, routeFinished, isTyping };
+  return {
+    sessionId, now, api, log, flush, goTo, poll, setProgress, fillGuess, setEstimate, setWaiting, showFatal,
+    watchVideo, routeFinished, isTyping, setupLegend, fillLegend, describeVideo, betweenRounds,
+  };
 })();

@@ -11,6 +11,7 @@
 
   Study.watchVideo(videos.A, "A", () => shownRound);
   Study.watchVideo(videos.B, "B", () => shownRound);
+  Study.setupLegend(document.getElementById("legend-toggle"), document.getElementById("legend"), () => shownRound);
 
   function replay(which) {
     Study.log("replay", { video: which }, shownRound);
@@ -62,9 +63,12 @@
   });
 
   function show(q) {
-    shownRound = q.round;
+    Study.fillLegend(document.getElementById("legend-list"), q.legend);
     for (const v of q.videos) {
       const el = videos[v.label];
+      const which = v.label === "A" ? "first" : "second";
+      Study.describeVideo(el, document.getElementById(`caption-${v.label.toLowerCase()}`),
+        `Video ${v.label}: the robot's ${which} way of tidying this table`, q.legend, v.duration);
       el.src = v.url;
       el.load();
       el.play().catch(() => {}); // muted autoplay is allowed; replay buttons otherwise
@@ -83,7 +87,8 @@
     Study.setProgress(s);
     Study.setEstimate(s);
     if (s.status === "waiting-for-answer" && s.question && s.question.round !== shownRound) {
-      show(s.question);
+      shownRound = s.question.round;
+      Study.betweenRounds(s, () => show(s.question));
     } else if (s.status === "waiting-for-learner") {
       round = null;
       setEnabled(false);

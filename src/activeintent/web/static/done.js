@@ -1,0 +1,101 @@
+// Done page: the robot's final attempt, then the end-of-session questionnaire. The learner's
+// final guess (in studies that show guesses) appears only after the questionnaire is sent, so
+// it cannot colour the participant's description of their own rule.
+"use strict";
+
+(() => {
+  const video = document.getElementById("final");
+  const form = document.getElementById("questionnaire");
+  const qStatus = document.getElementById("q-status");
+  const submit = document.getElementById("q-submit");
+  let state = null;
+
+  Study.watchVideo(video, "final", () => null);
+  Study.setupLegend(document.getElementById("legend-toggle"), document.getElementById("legend"), () => null);
+  document.getElementById("replay").addEventListener("click", () => {
+    Study.log("replay", { video: "final" });
+    video.currentTime = 0;
+    video.play().catch(() => {});
+  });
+
+  function finish(s) {
+    form.classList.add("hidden");
+    document.getElementById("finished").classList.remove("hidden");
+    const box = document.getElementById("estimate");
+    const guess = s && s.estimate;
+    box.classList.toggle("hidden", !guess);
+    Study.fillGuess(box, guess || null);
+  }
+
+  form.addEventListener("submit", async (e) => {
+    e.preventDefault();
+    if (!state) return;
+    const asks = state.questionnaire.asks_final_attempt;
+    const picked = form.querySelector('input[name="final_attempt"]:checked');
+    const rule = document.getElementById("q-rule").value.trim();
+    const comments = document.getElementById("q-comments").value.trim();
+    const missing = [];
+    if (asks && !picked) missing.push("whether the final attempt did what you wanted");
+    if (!rule) missing.push("your rule");
+    if (missing.length) {
+      qStatus.textContent = `Please answer ${missing.join(" and ")}.`;
+      qStatus.classList.add("error");
+      (asks && !picked ? form.querySelector('input[name="final_attempt"]') : document.getElementById("q-rule")).focus();
+      return;
+    }
+    const body = { rule, client_ts: Study.now() };
+    if (asks) body.final_attempt = picked.value;
+    if (comments) body.comments = comments;
+    submit.disabled = true;
+    qStatus.classList.remove("error");
+    qStatus.textContent = "Sending…";
+    try {
+      await Study.api("POST", `/api/sessions/${Study.sessionId}/questionnaire`, body);
+      Study.log("questionnaire_sent", { final_attempt: body.final_attempt ?? null });
+      finish(state);
+    } catch (err) {
+      if (err.code === "already_submitted") { finish(state); return; }
+      Study.log("questionnaire_rejected", { error: err.message });
+      qStatus.textContent = `Not saved: ${err.message}`;
+      qStatus.classList.add("error");
+      submit.disabled = false;
+    }
+    Study.flush();
+  });
+
+  Study.log("page_load", { page: "done" });
+  Study.poll((s) => {
+    Study.setProgress(s);
+    if (s.status === "waiting-for-answer") {
+      return Study.goTo(s.signal === "preference" ? "/preference" : "/clicker");
+    }
+    if (s.status === "waiting-for-learner") return;
+    const first = state === null;
+    state = s;
+    Study.setWaiting(false);
+    if (s.questionnaire.submitted) {
+      finish(s);
+      if (!first) return;
+    }
+    if (!first) return;
+    document.getElementById("q-final").classList.toggle("hidden", !s.questionnaire.asks_final_attempt);
+    if (s.status !== "finished") {
+      document.getElementById("thanks-text").textContent =
+        "The session ended early, so there is no final attempt to show. Please still tell us about your rule.";
+      document.getElementById("final-card").classList.add("hidden");
+      Study.log("ended_early", { status: s.status });
+    } else if (s.final_video) {
+      Study.fillLegend(document.getElementById("legend-list"), s.final_legend);
+      Study.describeVideo(video, document.getElementById("final-caption"),
+        "The robot's final attempt on a new table", s.final_legend, s.final_video.duration);
+      video.src = s.final_video.url;
+      video.play().catch(() => {});
+    } else {
+      document.getElementById("final-card").classList.add("hidden");
+    }
+    if (s.design === "assigned-rule") {
+      document.getElementById("q-rule-label").textContent =
+        "In your own words, what rule were you teaching the robot?";
+    }
+  });
+})();
