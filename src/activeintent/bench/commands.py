@@ -19,13 +19,33 @@ def _split(text: str) -> list[str]:
     return [t.strip() for t in text.split(",") if t.strip()]
 
 
+# --preset NAME: a benchmark defined once. table1 = the paper's Table 1: its three methods on its
+# four intentions, 5 trials each, K = 5 signals.
+PRESETS = {"table1": {"methods": ["preference", "mllm", "mllm-llm"], "suite": "paper", "trials": 5, "budget": 5}}
+
+
+def _apply_preset(preset: str, methods: str, intentions: str, budget: int) -> tuple[str, str, int]:
+    """(methods, suite, trials) of the preset; options that would change what it measures are refused."""
+    if preset not in PRESETS:
+        raise ValueError(f"unknown preset {preset!r}; valid presets: {', '.join(PRESETS)}")
+    p = PRESETS[preset]
+    if methods and _split(methods) != p["methods"]:
+        raise ValueError(f"--preset {preset} runs the methods {', '.join(p['methods'])}; drop --methods")
+    if intentions:
+        raise ValueError(f"--preset {preset} runs the {p['suite']} suite; drop --intentions")
+    if budget != p["budget"]:
+        raise ValueError(f"--preset {preset} gives K = {p['budget']} signals; drop --budget")
+    return ",".join(p["methods"]), p["suite"], p["trials"]
+
+
 def bench(
     methods: Annotated[str, typer.Option("--methods", help="Comma-separated methods (default: bayes-preference, bayes-stop and the baselines)")] = "",
     suite: Annotated[str, typer.Option("--suite", help="Comma-separated suites: paper, library, heldout")] = "paper",
     intentions: Annotated[str, typer.Option("--intentions", help="Comma-separated intentions (instead of --suite)")] = "",
     intention_file: Annotated[list[str] | None, typer.Option("--intention-file", help="Add your own: path.py:NAME (repeatable)")] = None,
     plugin: opt.Plugin = None,
-    trials: Annotated[int, typer.Option("--trials", min=1, help="Episodes per method and intention")] = 20,
+    preset: Annotated[str | None, typer.Option("--preset", help="table1: the paper's Table 1 (preference, mllm, mllm-llm; the paper's four intentions; 5 trials; K = 5)")] = None,
+    trials: Annotated[int | None, typer.Option("--trials", min=1, help="Episodes per method and intention (default 20; --preset table1: 5)")] = None,
     budget: opt.Budget = D.budget,
     seed: opt.Seed = D.seed,
     test_scenes: opt.TestScenes = D.test_scenes,
@@ -40,6 +60,9 @@ def bench(
     cache_mode: opt.CacheMode = D.cache_mode,
     executor: opt.Executor = D.executor,
     retriever: opt.Retriever = D.retriever,
+    variant: opt.Variant = D.variant,
+    epsilon: opt.Epsilon = D.epsilon,
+    early_threshold: opt.EarlyThreshold = D.early_threshold,
     curve: Annotated[bool, typer.Option(help="Score after every signal (off: only at k = K; for slow models)")] = True,
     jobs: Annotated[int, typer.Option("--jobs", min=1, help="Episodes run in parallel (processes; with --backend ray and no cluster: the CPUs of the local Ray)")] = 1,
     backend: Annotated[str, typer.Option("--backend", help="local (process pool) | ray (one task per episode; docs/scaling.md)")] = "local",
@@ -70,9 +93,14 @@ def bench(
     console = Console()
     try:
         check_backend(backend)
+        if preset is not None:
+            methods, suite, preset_trials = _apply_preset(preset, methods, intentions, budget)
+            trials = trials or preset_trials
+        trials = trials or 20
         run = opt.run_options(plugins=plugin, budget=budget, test_scenes=test_scenes, env=env, user=user,
                               new_scene=new_scene, prior=prior, llm=llm, vlm=vlm, base_url=base_url, cache=cache,
-                              cache_mode=cache_mode, executor=executor, retriever=retriever, curve=curve, video="none")
+                              cache_mode=cache_mode, executor=executor, retriever=retriever, variant=variant,
+                              epsilon=epsilon, early_threshold=early_threshold, curve=curve, video="none")
         method_list = _split(methods) or ["bayes-preference", "bayes-stop", "zero-signal", "random-query"]
         for m in method_list:
             check_options(run.model_copy(update={"method": m}))
@@ -113,7 +141,7 @@ def bench(
             progress.stop()
             console.print(f"[red]error:[/red] {err}")
             raise typer.Exit(2) from None
-    settings = {**protocol_fields(run), "trials": trials, "seed": seed}
+    settings = {**protocol_fields(run), "trials": trials, "seed": seed, **({"preset": preset} if preset else {})}
     all_intentions = intention_list + list(intention_file or [])
     report = write_report(records, method_list, all_intentions, out, settings)
     plot_success_vs_signals(records, method_list, budget, out)

@@ -11,13 +11,28 @@ import numpy as np
 
 from activeintent.suites import suite_of
 
-# The paper's Table 1: success judged by people, 5 trials each. Models per the paper's text:
-# the preference method used the LLM (GPT-4); mllm used GPT-4V alone; mllm-llm GPT-4V + GPT-4.
+# The paper's Table 1: success judged by people, 5 trials each, 5 signals. Models per the paper's
+# §4.1: the LLM was gpt-4-1106-preview, the vision-language model gpt-4-vision-preview; the
+# preference method used the LLM, mllm the vision model alone, mllm-llm the vision model to
+# retrieve r and the LLM to reason.
+PAPER_LLM, PAPER_VLM = "gpt-4-1106-preview", "gpt-4-vision-preview"
 PAPER_TABLE1 = {
-    "preference": ({"align": 0.6, "stack": 0.0, "color-match": 0.6, "color-mismatch": 0.4}, "GPT-4"),
-    "mllm": ({"align": 0.4, "stack": 0.2, "color-match": 0.8, "color-mismatch": 0.4}, "GPT-4V"),
-    "mllm-llm": ({"align": 0.6, "stack": 0.4, "color-match": 0.8, "color-mismatch": 0.6}, "GPT-4V + GPT-4"),
+    "preference": ({"align": 0.6, "stack": 0.0, "color-match": 0.6, "color-mismatch": 0.4}, PAPER_LLM),
+    "mllm": ({"align": 0.4, "stack": 0.2, "color-match": 0.8, "color-mismatch": 0.4}, PAPER_VLM),
+    "mllm-llm": ({"align": 0.6, "stack": 0.4, "color-match": 0.8, "color-mismatch": 0.6},
+                 f"{PAPER_VLM} (r) + {PAPER_LLM} (z, y)"),
 }
+
+
+def our_model(method: str, settings: dict) -> str:
+    """The model(s) behind one of our rows of a paper method, as the run's options chose them."""
+    llm, vlm = settings.get("llm", "?"), settings.get("vlm") or settings.get("llm", "?")
+    if method == "mllm":
+        return str(vlm)
+    if method == "mllm-llm":
+        r = f"{vlm} (r)" if settings.get("retriever") == "vision" else "symbolic retriever (r)"
+        return f"{r} + {llm} (z, y)"
+    return str(llm)
 BASELINES = ("zero-signal", "random-query", "random-query-preference")
 
 
@@ -81,15 +96,25 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
             phys = [r for r in ok if r.get("physics_disagreements") is not None]
             dis = f"{sum(r['physics_disagreements'] for r in phys)} / {len(phys)} ep." if phys else "–"
             label = f"*{m}* (baseline)" if m in BASELINES else m
+            if m in PAPER_TABLE1 and ok:
+                label += " [" + "/".join(sorted({str(r.get("variant") or "structured") for r in ok})) + "]"
             lines.append(f"| {label} | " + " | ".join(cells) + f" | **{rate([r['success'] for r in ok])}** | "
                          f"{signals:.1f} | {new}/{total} | {excl:.1f} | {dis} | {len(every) - len(ok)} |")
         if suite == "paper":
             cols = [i for i in names if i in PAPER_TABLE1["preference"][0]]
-            lines += ["", "The paper's Table 1 (reference, not ours: people judged success, 5 trials, 5 signals):", "",
-                      "| method (paper) | model | " + " | ".join(cols) + " | average |", "|" + "---|" * (len(cols) + 3)]
+            lines += ["", "The paper's Table 1 (people judged success, 5 trials, 5 signals) with our rows of the "
+                      "same methods beside it (success@K, mean over episodes; n = episodes):", "",
+                      "| method | model | variant | " + " | ".join(cols) + " | average |", "|" + "---|" * (len(cols) + 4)]
             for m, (row, model) in PAPER_TABLE1.items():
-                lines.append(f"| {m} (paper) | {model} | " + " | ".join(f"{row[i]:.1f}" for i in cols)
+                lines.append(f"| {m} (paper) | {model} | – | " + " | ".join(f"{row[i]:.1f}" for i in cols)
                              + f" | {np.mean(list(row.values())):.2f} |")
+                ours = [r for i in cols for r in by.get((m, i), []) if _ok(r)]
+                if m in methods and ours:
+                    variants = "/".join(sorted({str(r.get("variant") or "structured") for r in ours}))
+                    cells = [f"{np.mean(v):.2f} (n={len(v)})" if (v := [r["success"] for r in by.get((m, i), []) if _ok(r)])
+                             else "–" for i in cols]
+                    lines.append(f"| {m} (ours) | {our_model(m, settings)} | {variants} | " + " | ".join(cells)
+                                 + f" | {np.mean([r['success'] for r in ours]):.2f} |")
         lines.append("")
     lines += ["## success@k (all suites pooled)", "", "| method | " + " | ".join(f"k={k}" for k in range((budget or 0) + 1)) + " |",
               "|" + "---|" * ((budget or 0) + 2)]

@@ -19,6 +19,7 @@ from pathlib import Path
 
 from pydantic import BaseModel, Field
 
+from activeintent.learners.registry import PAPER_METHODS
 from activeintent.protocol import trial_seeds
 from activeintent.records import append_result, dumps, read_results
 from activeintent.runner import RunOptions
@@ -60,7 +61,8 @@ class BenchOptions(BaseModel):
 def protocol_fields(run: RunOptions) -> dict:
     """What every results line records about how it was measured."""
     return {"env": run.env, "user_preset": run.user, "budget": run.budget, "new_scene": run.new_scene,
-            "prior": run.prior, "test_scenes": run.test_scenes, "llm": run.llm, "executor": run.executor}
+            "prior": run.prior, "test_scenes": run.test_scenes, "llm": run.llm, "executor": run.executor,
+            "vlm": run.vlm, "retriever": run.retriever, "variant": run.variant}
 
 
 def run_item(item: WorkItem, options: RunOptions, bench_seed: int, out: str, keep: bool) -> dict:
@@ -120,12 +122,23 @@ def run_bench(options: BenchOptions, out: Path, on_done: Callable[[dict, int, in
 _SETTINGS = ("seed", "run")  # methods, intentions and trials may grow on resume; these may not change
 
 
+def _legacy_run(run: dict) -> dict:
+    """Values of options that did not exist when an older folder was made: the paper's methods
+    ran what is now ``--variant structured``, and ε was also eq. 3's threshold."""
+    return {"variant": "structured", "early_threshold": run.get("epsilon", 2.0)}
+
+
 def _check_same_settings(options: BenchOptions, path: Path) -> None:
     """Resuming into a folder made with other settings would mix incomparable episodes."""
     if not path.exists():
         return
     before = json.loads(path.read_text())
     now = json.loads(options.model_dump_json())
+    if isinstance(before.get("run"), dict):  # options added since: the value they had in effect then
+        before["run"] = {**_legacy_run(before["run"]), **before["run"]}
+        if not any(m in PAPER_METHODS for m in before.get("methods", []) + now["methods"]):
+            before["run"].pop("variant", None)  # only the paper's methods have variants
+            now["run"].pop("variant", None)
     changed = [k for k in _SETTINGS if before.get(k) != now.get(k)]
     if changed:
         diff = "; ".join(f"{k}: {before.get(k)} → {now.get(k)}" for k in changed)

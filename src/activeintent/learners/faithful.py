@@ -249,7 +249,7 @@ class FaithfulPreferenceLearner(_FaithfulLearner):
         h = record.answer
         assert isinstance(h, PreferenceAnswer)
         a, b = (record.estimate.goals + ["", ""])[:2]
-        self.pending.append(TextPart(text=_section("faithful_feedback", h.choice or "cant_choose", a=a, b=b)))
+        self.pending.append(TextPart(text=_section("faithful_feedback", f"choice_{h.choice}" if h.choice in ("A", "B") else "cant_choose", a=a, b=b)))
         for label, traj, failure in zip("AB", trajectories, record.failures + [None, None], strict=False):
             if not traj.moved_anything:
                 self.pending.append(TextPart(text=_section("faithful_feedback", "failed", label=label,
@@ -328,6 +328,7 @@ class FaithfulMllmLearner(_FaithfulStopLearner):
     def __init__(self, llm: ChatModel, config: FaithfulConfig | None = None):
         super().__init__(llm, config)
         self.retriever = "vision" if llm.accepts_images else "symbolic"
+        self.sees_images = llm.accepts_images
 
     def _feedback(self, record: RoundRecord, trajectories: list[Trajectory]) -> str | None:
         if not trajectories:
@@ -335,6 +336,9 @@ class FaithfulMllmLearner(_FaithfulStopLearner):
         traj = trajectories[0]
         text, ph = self._outcome(record, traj)
         self.pending.append(TextPart(text=text))
+        # Pictures when the model sees images and the env draws them (--env symbolic cannot):
+        # else the pictures described; ``retriever`` records which, round by round.
+        self.retriever = "vision" if self.sees_images and traj.renderer is not None else "symbolic"
         if ph.moments:  # a stop: show what the person saw
             self.pending.append(TextPart(text=_section("faithful_feedback", "evidence")))
             if self.retriever == "vision":
