@@ -170,6 +170,10 @@ def nasty(rng: random.Random):
 def good_body(rng: random.Random, endpoint: str) -> dict:
     if endpoint == "sessions":
         return {"participant": rng.choice(["P01", "fuzz", "é"]), "seed": rng.randrange(100)}
+    if endpoint == "questionnaire":
+        # well formed, it is refused anyway (409) while the session is in progress
+        return {"final_attempt": rng.choice(["yes", "partly", "no"]), "rule": rng.choice(["mine", "é\nx", "a" * 300]),
+                "comments": rng.choice([None, "ok"]), "client_ts": 1.7e9}
     if endpoint == "answer":
         # never the waiting round 1 when well formed: the session stays put (its answers are
         # the targeted and concurrent tests' business) and no episode runs during the fuzzing
@@ -244,6 +248,7 @@ def fuzz_path(rng: random.Random, sid: str, endpoint: str) -> str:
         "answer": f"/api/sessions/{s}/answer",
         "events": f"/api/sessions/{s}/events",
         "result": f"/api/sessions/{s}/result",
+        "questionnaire": f"/api/sessions/{s}/questionnaire",
         "files": f"/api/sessions/{s}/files/{name}",
         "other": rng.choice(["/", "/preference", "/clicker", "/done", "/api/config", "/openapi.json",
                              "/static/style.css", "/static/%2e%2e/server.py", "/api", "/api/",
@@ -267,7 +272,7 @@ def test_random_malformed_requests_get_4xx_and_leave_only_valid_json(live_server
     seen: dict[int, int] = {}
     for i in range(FUZZ_REQUESTS):
         endpoint = rng.choice(["sessions", "state", "answer", "answer", "events", "events", "result",
-                               "files", "files", "other"])
+                               "questionnaire", "files", "files", "other"])
         method = rng.choice(METHODS)
         path = fuzz_path(rng, sid, endpoint)
         body = headers = None
