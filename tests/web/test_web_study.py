@@ -196,6 +196,10 @@ def test_free_rule_session_questionnaire_and_guess_shown_always(live_server):
     info = json.loads((folder / "session.json").read_text())
     assert info["status"] == "finished" and info["show_estimate"] == "always" and info["design"] == "free-rule"
     assert info["ended"] >= info["created"]
+    events = [json.loads(x) for x in (folder / "events.jsonl").read_text().splitlines()]
+    presented = [e for e in events if e["type"] == "round_presented"]
+    assert [e["estimate_shown"] for e in presented] == [False, True]  # what the participant saw, per round
+    assert all(e["estimate"] and 0 <= e["confidence"] <= 1 for e in presented)
 
     before = sorted(p.name for p in folder.iterdir())
     bad = [

@@ -336,7 +336,7 @@ class WebSession:
             scene=list(q.scene.objects),
             estimate=self.estimate,
             confidence=self.guess.confidence if self.guess else None,
-            estimate_shown=self.config.show_estimate if self._guess_visible(self.guess) else "no",
+            estimate_shown=self._guess_visible(self.guess),  # how: the study's show_estimate
             videos=[v.model_dump() for v in videos],
         )
         return videos
