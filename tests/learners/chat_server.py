@@ -82,7 +82,9 @@ class ChatServer:
         if name is None:  # Code as Policies: a program for the instruction in the last comment
             return f"```python\n{PROGRAM}```"
         if name == "FaithfulScene":
-            return json.dumps({"reasoning": f"draw {rng.random():.6f}", "objects": rng.choice(SCENES)})
+            objects = rng.choice(SCENES)
+            return json.dumps({"reasoning": f"draw {rng.random():.6f}", "blocks": [o for o in objects if o.endswith("block")],
+                               "bowls": [o for o in objects if o.endswith("bowl")]})
         if name in ("FaithfulAnswer", "FaithfulPairAnswer"):
             out = {"reasoning": f"draw {rng.random():.6f}", "preference": rng.choice(PREFERENCES)}
             if name == "FaithfulAnswer":

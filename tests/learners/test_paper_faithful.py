@@ -56,7 +56,7 @@ def require_sandbox() -> None:
 def respond(messages, schema):
     title = (schema or {}).get("title", "")
     if title == "FaithfulScene":
-        return {"reasoning": "bowls that match blocks", "objects": list(SCENE.objects)}
+        return {"reasoning": "bowls that match blocks", "blocks": SCENE.blocks, "bowls": SCENE.bowls}
     if title in ("FaithfulAnswer", "FaithfulPairAnswer"):
         out = {"reasoning": "the stop came early, so the first move was wrong", "preference": "matching colours"}
         if title == "FaithfulAnswer":
@@ -362,3 +362,16 @@ def test_resuming_a_folder_made_before_variants_existed(tmp_path):
         _check_same_settings(old.model_copy(update={"methods": ["mllm"]}), tmp_path / "bench.json")
     structured = old.model_copy(update={"methods": ["mllm"], "run": RunOptions(video="none", variant="structured")})
     _check_same_settings(structured, tmp_path / "bench.json")
+
+
+def test_the_scene_choice_is_a_turn_of_the_conversation():
+    model = ScriptedModel(respond=respond, accepts_images=False)
+    learner = FaithfulMllmLlmLearner(model, config=FaithfulConfig(seed=1))
+    assert learner.design_scene(np.random.default_rng(0)) == SCENE
+    learner.estimate(SCENE, state())
+    assert [m.role for m in model.calls[-1].messages] == ["system", "user", "assistant", "user"]
+    too_many = ScriptedModel([{"reasoning": "r", "blocks": ["red block", "blue block", "green block"],
+                               "bowls": ["red bowl", "blue bowl", "green bowl"]}], accepts_images=False)
+    learner = FaithfulMllmLlmLearner(too_many, config=FaithfulConfig(seed=1))
+    assert learner.design_scene(np.random.default_rng(0)) is None  # 6 objects: the episode samples one
+    assert "at most 5" in learner.drain_transcript()[-1]["unusable"]

@@ -167,9 +167,10 @@ class _FaithfulLearner(Learner):
             return None
         self._new_scene_asked = False
         try:
-            scene = Scene(objects=answer.objects)  # type: ignore[attr-defined]
-            if len(scene.blocks) < 2 or not scene.bowls:
-                raise SceneError(f"a scene needs at least 2 blocks and a bowl, got {scene}")
+            objects = [*answer.blocks, *answer.bowls]  # type: ignore[attr-defined]
+            if len(objects) > 5:
+                raise SceneError(f"a scene holds at most 5 objects, got {len(objects)}: {', '.join(objects)}")
+            scene = Scene(objects=objects)
             layout(scene, 0)
         except (ValidationError, SceneError) as err:
             self.transcript.append({"template": "faithful_scene", "unusable": str(err).splitlines()[0]})

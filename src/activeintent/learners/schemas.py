@@ -103,7 +103,10 @@ class FaithfulRetrieval(BaseModel):
 
 
 def faithful_scene_schema() -> type[BaseModel]:
-    """The learner's choice of 3–5 objects, with its reasoning first."""
-    Obj = Literal[tuple(ALL_OBJECTS)]  # type: ignore[valid-type]
+    """The learner's choice of 3–5 objects (2–4 blocks, 1–3 bowls: a scene where blocks can
+    move somewhere), with its reasoning first."""
+    Block = Literal[tuple(o for o in ALL_OBJECTS if o.endswith("block"))]  # type: ignore[valid-type]
+    Bowl = Literal[tuple(o for o in ALL_OBJECTS if o.endswith("bowl"))]  # type: ignore[valid-type]
     return create_model("FaithfulScene", reasoning=(str, _reasoning()),  # type: ignore[call-overload]
-                        objects=(list[Obj], Field(min_length=3, max_length=5)))
+                        blocks=(list[Block], Field(min_length=2, max_length=4)),
+                        bowls=(list[Bowl], Field(min_length=1, max_length=3)))
