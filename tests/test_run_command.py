@@ -13,15 +13,17 @@ runner = CliRunner()
 
 def test_run_writes_summary_rounds_and_gifs(tmp_path):
     out = tmp_path / "run"
-    res = runner.invoke(app, ["run", "--method", "bayes-stop", "--intention", "stack", "--rounds", "2",
-                              "--llm", "none", "--seed", "1", "--out", str(out)])
+    res = runner.invoke(app, ["run", "--method", "bayes-stop", "--intention", "stack", "--budget", "2",
+                              "--llm", "none", "--seed", "1", "--test-scenes", "2", "--video", "all",
+                              "--out", str(out)])
     assert res.exit_code == 0, res.output
     summary = json.loads((out / "summary.json").read_text())
     assert summary["method"] == "bayes-stop" and summary["intention"] == "stack"
-    assert summary["signals_used"] <= 2 and summary["final_goal"]
+    assert summary["signals_used"] == 2 == summary["budget"] and len(summary["success_at"]) == 3
+    assert summary["final_goal"] and summary["env"] == "pybullet" and summary["user"]["profile"]["name"] == "human"
     assert len((out / "rounds.jsonl").read_text().splitlines()) == summary["rounds_used"]
     assert list(out.glob("round1_*.gif")) and (out / "final.gif").exists()
-    assert ("SUCCESS" if summary["success"] else "FAILURE") in res.output
+    assert f"success@2 = {summary['success']:.2f}" in " ".join(res.output.split())
 
 
 def test_bad_options_exit_2_with_the_valid_choices(tmp_path):
@@ -33,11 +35,16 @@ def test_bad_options_exit_2_with_the_valid_choices(tmp_path):
     assert res.exit_code == 2 and "--llm" in res.output
     res = runner.invoke(app, ["run", "--llm", "chatgpt", "--out", str(tmp_path)])
     assert res.exit_code == 2 and "openai:" in res.output
+    res = runner.invoke(app, ["run", "--user", "robot", "--llm", "none", "--out", str(tmp_path)])
+    assert res.exit_code == 2 and "human" in res.output and "exact" in res.output
+    res = runner.invoke(app, ["run", "--budget", "-1", "--out", str(tmp_path)])
+    assert res.exit_code == 2 and "--budget" in res.output
 
 
 def test_unreachable_model_exits_3(tmp_path):
     res = runner.invoke(app, ["run", "--method", "preference", "--llm", "openai:gpt-x", "--base-url",
-                              "http://127.0.0.1:9/v1", "--cache-mode", "off", "--rounds", "1", "--out", str(tmp_path)],
+                              "http://127.0.0.1:9/v1", "--cache-mode", "off", "--budget", "1", "--env", "symbolic",
+                              "--out", str(tmp_path)],
                         env={"OPENAI_API_KEY": "test"})
     assert res.exit_code == 3, res.output
     assert "model" in res.output.lower()
