@@ -20,6 +20,7 @@ _COMMAND_MODULES = (
     "activeintent.act.commands",
     "activeintent.bench.commands",
     "activeintent.bench.perf",
+    "activeintent.bench.verify",
     "activeintent.intentions.commands",
     "activeintent.learners.bayes.commands",
     "activeintent.llm.commands",

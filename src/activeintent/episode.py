@@ -156,18 +156,6 @@ class EpisodeResult(BaseModel):
     config: dict = Field(default_factory=dict)
 
 
-def answer_kind(answer: Answer) -> str:
-    """A short label of an answer, for counts and tables."""
-    if answer.new_scene:
-        return "new_scene"
-    d = answer.model_dump(exclude={"signal", "new_scene"})
-    if "choice" in d:
-        return str(d["choice"])
-    if "stop_time" in d:
-        return "no_stop" if d["stop_time"] is None else "stop"
-    return answer.signal
-
-
 @dataclass
 class _Clock:
     split: dict[str, float] = field(default_factory=lambda: {
@@ -421,6 +409,7 @@ class Episode:
 
 
 def answer_kind_from_dump(d: dict) -> str:
+    """A short label of an answer (as stored), for counts and tables."""
     if d.get("new_scene"):
         return "new_scene"
     if "choice" in d:
