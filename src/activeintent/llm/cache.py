@@ -2,8 +2,10 @@
 
 The key is the sha256 of backend, model name, messages (images by their sha256), sampling
 parameters, schema and the caller's prompt-template version, so two runs with the same seed
-and a warm cache make identical calls and get identical answers. Several processes may write
-to one file (WAL journal, busy timeout).
+and a warm cache make identical calls and get identical answers. Several processes on one
+machine may write to one file (WAL journal, busy timeout). WAL needs every process on the
+same host: workers on several machines use one cache file each on a local disk, merged
+afterwards (docs/scaling.md).
 """
 
 from __future__ import annotations
