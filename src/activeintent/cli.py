@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import importlib
 
 import typer
@@ -30,6 +31,27 @@ _COMMAND_MODULES = (
 
 for _module in _COMMAND_MODULES:
     importlib.import_module(_module).register(app)
+
+# Commands that only measure or demonstrate: in check-only mode their options are parsed and
+# nothing runs (run, bench and serve validate deeper themselves).
+_MEASURING = {"sim-demo", "sim-bench", "model-bench", "act-bench", "bayes-bench", "perf-bench"}
+
+
+def _checked(callback):
+    @functools.wraps(callback)
+    def wrapper(*args, **kwargs):
+        from activeintent.options import check_only
+
+        if check_only():
+            return None
+        return callback(*args, **kwargs)
+
+    return wrapper
+
+
+for _info in app.registered_commands:
+    if (_info.name or "") in _MEASURING:
+        _info.callback = _checked(_info.callback)
 
 
 if __name__ == "__main__":

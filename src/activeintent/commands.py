@@ -125,6 +125,17 @@ def run(
     name = intention or (Path(intention_file.split(":")[0]).stem if intention_file else DEFAULT_INTENTION)
     out_dir = out or Path("runs") / f"{method}-{name}-seed{seed}"
     live = LiveTable(console, method, budget, seed)
+    if opt.check_only():
+        try:
+            from activeintent.runner import check_options
+            from activeintent.suites import resolve
+
+            check_options(options)
+            resolve(intention or (None if intention_file else DEFAULT_INTENTION), intention_file)
+        except (ValueError, FileNotFoundError) as err:
+            console.print(f"[red]error:[/red] {err}")
+            raise typer.Exit(2) from None
+        return
     try:
         with console.status("loading models and simulator…"):
             episode = build_episode(options, out_dir, observers=[live])

@@ -38,6 +38,14 @@ Video = Annotated[str, typer.Option("--video", help="GIFs written: none | final 
 Out = Annotated[Path | None, typer.Option("--out", help="Output folder")]
 
 
+def check_only() -> bool:
+    """ACTIVEINTENT_CHECK_ONLY=1: commands validate their options and inputs, then stop before
+    the work (the docs test runs every documented command this way)."""
+    import os
+
+    return os.environ.get("ACTIVEINTENT_CHECK_ONLY") == "1"
+
+
 def run_options(**values) -> RunOptions:
     """RunOptions from CLI values; a bad value becomes a message naming the option."""
     from pydantic import ValidationError

@@ -114,6 +114,8 @@ def bench(
     except (ValueError, FileNotFoundError) as err:
         console.print(f"[red]error:[/red] {err}")
         raise typer.Exit(2) from None
+    if opt.check_only():
+        return
     options = BenchOptions(methods=method_list, intentions=intention_list, intention_files=list(intention_file or []),
                            trials=trials, seed=seed, jobs=jobs, backend=backend, ray_address=ray_address,
                            retry_errors=retry_errors,

@@ -84,6 +84,8 @@ def serve(
     limits = Limits(max_sessions_per_client=max_sessions_per_client,
                     max_new_sessions_per_hour=max_new_sessions_per_hour, idle_timeout=idle_timeout * 60,
                     max_body_bytes=max_request_kb * 1024, events_quota_bytes=int(events_quota_mb * 2**20))
+    if opt.check_only():
+        return
     app = create_app(config, runner_builder(config, **extra), limits=limits)
     console = Console()
     shown = "localhost" if host in ("127.0.0.1", "::1") else host
