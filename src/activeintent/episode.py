@@ -237,12 +237,13 @@ class Episode:
                 self.learner.execution_failed(goal, failure or "")
         raise AssertionError("unreachable")
 
-    def _video(self, traj: Trajectory, name: str) -> None:
+    def _video(self, traj: Trajectory, name: str, stop_time: float | None = None) -> None:
         if self.out is None or not self.env.renders or traj.renderer is None:
             return
         from activeintent.sim.video import export_video  # only envs that render reach here
 
-        self.clock.timed("video_s", export_video, traj, self.out / f"{name}.gif", fps=self.config.video_fps)
+        self.clock.timed("video_s", export_video, traj, self.out / f"{name}.gif", fps=self.config.video_fps,
+                         stop_time=stop_time)
 
     # -- scoring -------------------------------------------------------------------------------
     def _test_set(self) -> list[tuple[Scene, int]]:
@@ -391,10 +392,12 @@ class Episode:
             traj = self.clock.timed("env_s", self.env.execute, plan)
             trajectories.append(traj)
             failures[i] = failures[i] or ("; ".join(s.reason or "" for s in traj.failures) or None)
-            if self.config.video == "all":
-                self._video(traj, f"round{index + 1}_{labels[i]}")
         self.emit("shown", index, scene, est, trajectories)
         h = self.clock.timed("user_s", self.user.respond, scene, trajectories)
+        if self.config.video == "all":  # after the answer, so a stop can be marked where it came
+            stop = getattr(h, "stop_time", None)
+            for label, traj in zip(labels, trajectories, strict=True):
+                self._video(traj, f"round{index + 1}_{label}", stop)
         record = RoundRecord(index=index, scene=scene, estimate=est, plans=plans, failures=failures, answer=h)
         r = self.clock.timed("learner_s", self.learner.observe, record, trajectories)
         return RoundLog(

@@ -237,3 +237,24 @@ def test_save_load_roundtrip(demo, tmp_path):
     assert loaded.steps[1].skill == demo.steps[1].skill
     assert loaded.final_state == demo.final_state and loaded.scene == demo.scene
     assert np.array_equal(render_frame(loaded, 2.0), render_frame(demo, 2.0))
+
+
+def test_a_stopped_round_video_ends_at_the_stop_with_a_marker(tmp_path):
+    import imageio.v2 as iio
+
+    from activeintent.runner import RunOptions, build_episode
+
+    build_episode(RunOptions(method="bayes-stop", intention="stack", env="pybullet", llm="none", user="exact",
+                             video="all", budget=1, test_scenes=1, seed=2), tmp_path).run()
+    from activeintent.records import read_rounds
+
+    (r,) = read_rounds(tmp_path / "rounds.jsonl")
+    frames = iio.mimread(tmp_path / "round1_y.gif")
+    red = [bool((f[:3, :, 0] > 200).all() and (f[:3, :, 1] < 60).all()) for f in frames]
+    stop = r["answer"]["stop_time"]
+    assert stop is not None  # seed 2: the exact user stops the first query
+    # the clip ends where the person stopped: the frames before it plain, the stop frame in red
+    # (held for a second; a GIF writer may merge the identical held frames into one)
+    before = sum(1 for k in range(1000) if k / 10 < stop)
+    assert not any(red[:before]) and all(red[before:]) and len(frames) >= before + 1
+    assert len(frames) <= before + 10

@@ -25,9 +25,11 @@ def frame_times(traj: Trajectory, fps: float) -> np.ndarray:
 
 def export_video(
     traj: Trajectory, path: str | Path, fps: float = 10, size: tuple[int, int] = (240, 240),
-    progress: Callable[[int, int], None] | None = None,
+    progress: Callable[[int, int], None] | None = None, stop_time: float | None = None,
 ) -> Path:
-    """Write ``path`` (.gif, .webm or .mp4, by suffix); ``progress(done, total)`` per frame."""
+    """Write ``path`` (.gif, .webm or .mp4, by suffix); ``progress(done, total)`` per frame.
+    With ``stop_time`` the video ends at the person's stop, its last frame held and framed in
+    red, so a record shows what was seen when the stop came."""
     import imageio.v2 as iio
 
     path = Path(path)
@@ -36,6 +38,8 @@ def export_video(
         raise ValueError(f"unsupported video format {suffix!r}; use one of {', '.join(FORMATS)}")
     path.parent.mkdir(parents=True, exist_ok=True)
     times = frame_times(traj, fps)
+    if stop_time is not None:
+        times = np.append(times[times < stop_time], [stop_time] * max(1, int(fps)))  # hold 1 s
     if suffix == ".gif":
         writer = iio.get_writer(path, mode="I", duration=1000.0 / fps, loop=0)
     else:
@@ -49,9 +53,19 @@ def export_video(
         )
     try:
         for i, t in enumerate(times):
-            writer.append_data(render_frame(traj, float(t), size=size))
+            frame = render_frame(traj, float(t), size=size)
+            if stop_time is not None and t >= stop_time:
+                frame = stop_marked(frame)
+            writer.append_data(frame)
             if progress:
                 progress(i + 1, len(times))
     finally:
         writer.close()
     return path
+
+
+def stop_marked(frame: np.ndarray, width: int = 4) -> np.ndarray:
+    """The frame with a red border: the moment the person pressed stop."""
+    out = frame.copy()
+    out[:width, :] = out[-width:, :] = out[:, :width] = out[:, -width:] = (220, 30, 30)
+    return out
