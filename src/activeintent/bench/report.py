@@ -83,8 +83,8 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
         suites[suite_of(i)].append(i)
     for suite, names in suites.items():
         lines += [f"## Suite: {suite}", ""]
-        lines += ["| method | " + " | ".join(_short(i) for i in names) + " | **all** | signals | new-scene answers | test scenes excluded | physics disagreements | errors |",
-                  "|" + "---|" * (len(names) + 7)]
+        lines += ["| method | " + " | ".join(_short(i) for i in names) + " | **all** | signals | new-scene answers | test scenes excluded | physics disagreements | errors | unscored |",
+                  "|" + "---|" * (len(names) + 8)]
         for m in methods:
             every = [r for i in names for r in by.get((m, i), [])]
             ok = [r for r in every if _ok(r)]
@@ -96,10 +96,11 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
             phys = [r for r in ok if r.get("physics_disagreements") is not None]
             dis = f"{sum(r['physics_disagreements'] for r in phys)} / {len(phys)} ep." if phys else "–"
             label = f"*{m}* (baseline)" if m in BASELINES else m
+            errors = sum(1 for r in every if r.get("error"))  # unscored: no test scene could show the intention
             if m in PAPER_TABLE1 and ok:
                 label += " [" + "/".join(sorted({str(r.get("variant") or "structured") for r in ok})) + "]"
             lines.append(f"| {label} | " + " | ".join(cells) + f" | **{rate([r['success'] for r in ok])}** | "
-                         f"{signals:.1f} | {new}/{total} | {excl:.1f} | {dis} | {len(every) - len(ok)} |")
+                         f"{signals:.1f} | {new}/{total} | {excl:.1f} | {dis} | {errors} | {len(every) - len(ok) - errors} |")
         if suite == "paper":
             cols = [i for i in names if i in PAPER_TABLE1["preference"][0]]
             lines += ["", "The paper's Table 1 (people judged success, 5 trials, 5 signals) with our rows of the "
