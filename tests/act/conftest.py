@@ -1,6 +1,5 @@
 from __future__ import annotations
 
-import os
 import socket
 import subprocess
 
@@ -17,22 +16,25 @@ def state() -> WorldState:
     return WorldState(positions=layout(scene, 3))
 
 
-@pytest.fixture(scope="session")
-def secret_env():
-    """A fake secret in the parent's environment before any sandbox worker starts."""
-    os.environ[SECRET_NAME] = SECRET_VALUE
-    yield SECRET_VALUE
-    os.environ.pop(SECRET_NAME, None)
+@pytest.fixture
+def secret_env(monkeypatch):
+    """A fake secret in the parent's environment for this test only."""
+    monkeypatch.setenv(SECRET_NAME, SECRET_VALUE)
+    return SECRET_VALUE
 
 
 def _sandbox(**kwargs):
-    sb = Sandbox(TEST_LIMITS, **kwargs)
-    sb.start()
+    # The worker starts while the parent's environment holds the fake secret, which is removed
+    # straight after, so it cannot leak into the rest of the test session.
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv(SECRET_NAME, SECRET_VALUE)
+        sb = Sandbox(TEST_LIMITS, **kwargs)
+        sb.start()
     return sb
 
 
 @pytest.fixture(scope="session")
-def sandbox(secret_env):
+def sandbox():
     """What `--executor cap` uses: namespaces, seccomp and the AST guard."""
     require_namespaces()
     sb = _sandbox(isolation="bwrap")
@@ -41,7 +43,7 @@ def sandbox(secret_env):
 
 
 @pytest.fixture(scope="session")
-def unguarded_sandbox(secret_env):
+def unguarded_sandbox():
     """No AST allow-list and all builtins: what is left is the OS layer (namespaces, seccomp,
     limits)."""
     require_namespaces()
@@ -51,7 +53,7 @@ def unguarded_sandbox(secret_env):
 
 
 @pytest.fixture(scope="session")
-def namespaces_only_sandbox(secret_env):
+def namespaces_only_sandbox():
     """No guard and no seccomp: the namespaces and resource limits alone."""
     require_namespaces()
     sb = _sandbox(isolation="bwrap", guard=False, seccomp=False)
@@ -60,7 +62,7 @@ def namespaces_only_sandbox(secret_env):
 
 
 @pytest.fixture(scope="session")
-def seccomp_only_sandbox(secret_env):
+def seccomp_only_sandbox():
     """No guard and no namespaces (the --unsafe-no-isolation mode): seccomp and resource limits
     alone (plus chroot and the drop to nobody when the tests run as root)."""
     sb = _sandbox(isolation="none", unsafe_no_isolation=True, guard=False)
