@@ -71,8 +71,9 @@ class HypothesisJudge:
 
     def judge(self, f: Facts) -> tuple[np.ndarray, np.ndarray]:
         """(satisfied, score) of the state behind ``f`` under every hypothesis."""
-        for h in self.hyps:
-            h.prefetch([f])
+        if ("judge", self.token) not in f.memo:  # query selection asks again and again
+            for h in self.hyps:
+                h.prefetch([f])
         return judge(self.hyps, f, self.token)
 
     def utility(self, state: WorldState) -> np.ndarray:
