@@ -299,7 +299,8 @@ class Episode:
         physics = self.env.name != "symbolic"
         try:
             if cfg.curve or cfg.budget == 0 or not self.learner.asks:
-                rate, test_logs = self._score(0, tests, physics and cfg.budget == 0)
+                # A learner that never asks is final at k = 0: score it in physics right away.
+                rate, test_logs = self._score(0, tests, physics and (cfg.budget == 0 or not self.learner.asks))
             else:  # slow learners (model calls) are scored at k = K only
                 rate = None
             success_at.append(rate)
@@ -325,7 +326,7 @@ class Episode:
             if not self.learner.asks or signals < cfg.budget:
                 # No more signals come (zero-signal baseline, or the learner finished): its answer
                 # stands for the rest of the budget.
-                if physics and (not self.learner.asks or signals > 0):
+                if physics and self.learner.asks and signals > 0:
                     rate, test_logs = self._score(signals, tests, True)
                 success_at += [rate] * (cfg.budget + 1 - len(success_at))
         except ModelError as err:
