@@ -36,6 +36,7 @@ from activeintent.learners.retrievers import (
     PromptH,
     as_images,
     as_view_text,
+    check_retriever,
     describe_view,
     faithful_prompt_h,
     faithful_symbolic_retrieval,
@@ -287,11 +288,7 @@ class FaithfulMllmLlmLearner(_FaithfulStopLearner):
                  retriever: Literal["vision", "symbolic"] = "symbolic", config: FaithfulConfig | None = None):
         super().__init__(llm, config)
         self.vlm = vlm or llm
-        if retriever == "vision" and not self.vlm.accepts_images:
-            raise ModelError(
-                f"The vision retriever needs a multimodal model, but {self.vlm.name} accepts no images; "
-                "use --retriever symbolic or give a --vlm that accepts images."
-            )
+        check_retriever(retriever, self.vlm)
         self.retriever = retriever
         self.vision: list[Message] = [Message(role="system", content=_section("faithful_eq4", "system"))]
 

@@ -23,6 +23,7 @@ from activeintent.learners.retrievers import (
     PromptH,
     as_images,
     as_text,
+    check_retriever,
     prompt_h,
     symbolic_retrieval,
     vision_messages,
@@ -227,11 +228,7 @@ class MllmLlmLearner(_StopLearner):
                  retriever: Literal["vision", "symbolic"] = "symbolic", config: PaperLearnerConfig | None = None):
         super().__init__(llm, config)
         self.vlm = vlm or llm
-        if retriever == "vision" and not self.vlm.accepts_images:
-            raise ModelError(
-                f"The vision retriever needs a multimodal model, but {self.vlm.name} accepts no images; "
-                "use --retriever symbolic or give a --vlm that accepts images."
-            )
+        check_retriever(retriever, self.vlm)
         self.retriever = retriever
 
     def observe(self, record: RoundRecord, trajectories: list[Trajectory]) -> str | None:

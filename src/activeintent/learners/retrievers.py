@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from activeintent.learners import prompts
-from activeintent.llm.base import ImagePart, Message, TextPart
+from activeintent.llm.base import ChatModel, ImagePart, Message, ModelError, TextPart
 from activeintent.signals.stop import StopAnswer
 from activeintent.world import WorldState, describe_skill, describe_state, relations
 from activeintent.world.trajectory import Trajectory
@@ -50,6 +50,15 @@ class PromptH:
     @property
     def image_labels(self) -> list[str]:
         return [m.label for m in self.moments]
+
+
+def check_retriever(retriever: str, vlm: ChatModel) -> None:
+    """The vision retriever reads images: refuse a model that accepts none, before any call."""
+    if retriever == "vision" and not vlm.accepts_images:
+        raise ModelError(
+            f"The vision retriever needs a multimodal model, but {vlm.name} accepts no images; "
+            "use --retriever symbolic or give a --vlm that accepts images."
+        )
 
 
 def prompt_h(traj: Trajectory, h: StopAnswer, goal: str, epsilon: float, early: float | None = None) -> PromptH:
