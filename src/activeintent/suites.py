@@ -1,7 +1,7 @@
 """Benchmark suites of hidden intentions: ``paper`` (the paper's four), ``library`` (the other
-built-in intentions) and ``heldout`` (written blind, before any learner change, in
-``bench/heldout.py``; reported separately). Names of every suite resolve everywhere an
-intention name is accepted.
+built-in intentions), ``heldout`` (written blind, before any learner change, in
+``bench/heldout.py``; reported separately) and ``dev`` (``bench/dev.py``: for tuning learners).
+Names of every suite resolve everywhere an intention name is accepted.
 """
 
 from __future__ import annotations
@@ -15,13 +15,19 @@ from activeintent.intentions.registry import (
     resolve_intention,
 )
 
-SUITE_NAMES = ("paper", "library", "heldout")
+SUITE_NAMES = ("paper", "library", "heldout", "dev")
 
 
 def _heldout() -> dict[str, Intention]:
     from activeintent.bench.heldout import heldout_intentions
 
     return {it.name: it for it in heldout_intentions()}
+
+
+def _dev() -> dict[str, Intention]:
+    from activeintent.bench.dev import dev_intentions
+
+    return {it.name: it for it in dev_intentions()}
 
 
 def suite(name: str) -> list[str]:
@@ -32,6 +38,8 @@ def suite(name: str) -> list[str]:
         return [n for n in INTENTION_NAMES if n not in PAPER_INTENTIONS]
     if name == "heldout":
         return list(_heldout())
+    if name == "dev":
+        return list(_dev())
     raise ValueError(f"Unknown suite {name!r}; valid suites: {', '.join(SUITE_NAMES)}.")
 
 
@@ -41,17 +49,24 @@ def suite_of(intention: str) -> str:
         return "file"
     if intention in PAPER_INTENTIONS:
         return "paper"
-    return "library" if intention in INTENTION_NAMES else "heldout"
+    if intention in INTENTION_NAMES:
+        return "library"
+    return "dev" if intention in _dev() else "heldout"
 
 
 def resolve(name: str | None, intention_file: str | None = None) -> Intention:
     """``--intention NAME`` (any suite) or ``--intention-file path.py:NAME``."""
     if name and not intention_file and name not in INTENTION_NAMES:
+        dev = _dev()
+        if name in dev:
+            return dev[name]
         held = _heldout()
         if name in held:
             return held[name]
         try:
             return get_intention(name)
         except IntentionError as err:
-            raise IntentionError(f"{err} Held-out intentions: {', '.join(held)}.") from None
+            raise IntentionError(
+                f"{err} Held-out intentions: {', '.join(held)}. Dev intentions: {', '.join(dev)}."
+            ) from None
     return resolve_intention(name, intention_file)

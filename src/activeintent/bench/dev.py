@@ -1,0 +1,1095 @@
+"""The dev suite: 16 hidden intentions of the kind people ask a tabletop robot for, used to
+tune learners (``--suite dev``). The held-out suite is never used for tuning; these were
+written without looking at it. Names start with ``dev-`` so that they can never clash with a
+name of another suite (``suites.resolve`` looks names up across suites).
+
+Conventions follow the built-in library: "front" is the bottom side of the table (−y, the
+side a block goes to with "in front of"), "left" is −x, warm / cool colours are
+world.WARM_COLORS / COOL_COLORS, and every plan is checked with the symbolic world model
+before it is returned.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Iterator
+from itertools import combinations
+
+import numpy as np
+
+from activeintent.intentions.arrangements import Align, AlignVertical
+from activeintent.intentions.base import Intention
+from activeintent.intentions.blockwise import BlockwiseIntention
+from activeintent.intentions.placement import (
+    ROW_PITCH,
+    TABLE_INNER,
+    free_spot,
+    grid,
+    is_clear,
+    is_warm,
+    nearest_first,
+    on_table,
+    top_first,
+    towers,
+    verified,
+)
+from activeintent.world import (
+    COLOR_NAMES,
+    COOL_COLORS,
+    WARM_COLORS,
+    PutAt,
+    PutIn,
+    PutNextTo,
+    PutOn,
+    Relations,
+    Scene,
+    Skill,
+    WorldState,
+    apply_skill,
+    relations,
+)
+from activeintent.world.scene import color_of
+from activeintent.world.skills import TABLE_POSITIONS
+
+CENTRE = np.array([0.0, -0.5])
+CORNERS = ("top left corner", "top right corner", "bottom left corner", "bottom right corner")
+RAINBOW = ("red", "orange", "yellow", "green", "cyan", "blue", "purple")
+SIDES = ("nearest", "left", "right", "front", "behind")
+FRONT_TOLERANCE = 0.055  # "right in front of a bowl": block centre at most this far to either side
+
+
+# --- scenes ------------------------------------------------------------------------------
+
+
+def _pick(rng: np.random.Generator, n: int, pool: Iterable[str] = COLOR_NAMES, exclude: Iterable[str] = ()) -> list[str]:
+    """``n`` distinct colours from ``pool`` (in palette order, so draws are reproducible)."""
+    pool, exclude = set(pool), set(exclude)
+    choices = [c for c in COLOR_NAMES if c in pool and c not in exclude]
+    return [str(c) for c in rng.choice(choices, size=n, replace=False)] if n else []
+
+
+def _scene(blocks: list[str], bowls: list[str]) -> Scene:
+    return Scene(objects=[f"{c} block" for c in blocks] + [f"{c} bowl" for c in bowls])
+
+
+def _warm_and_cool(rng: np.random.Generator, n_warm: int, n_cool: int) -> list[str]:
+    blocks = _pick(rng, n_warm, WARM_COLORS) + _pick(rng, n_cool, COOL_COLORS)
+    rng.shuffle(blocks)
+    return blocks
+
+
+def _bowl_count(rng: np.random.Generator, n_blocks: int, most: int = 2) -> int:
+    """Bowls for a scene of 3–5 objects with ``n_blocks`` blocks (at most ``most``)."""
+    low, high = max(0, 3 - n_blocks), min(most, 5 - n_blocks)
+    return int(rng.integers(low, high + 1))
+
+
+# --- planning helpers ----------------------------------------------------------------------
+
+
+def _first_verified(intention: Intention, state: WorldState, plans: Iterable[list[Skill] | None]) -> list[Skill] | None:
+    """The first candidate plan that the world model says satisfies ``intention``."""
+    for steps in plans:
+        if steps is not None and (found := verified(intention, state, steps)) is not None:
+            return found
+    return None
+
+
+def _park(state: WorldState, block: str, accept: Callable[[WorldState], bool] | None = None) -> Skill | None:
+    """Put ``block`` somewhere free on the table (not on a block, not in a bowl)."""
+
+    def ok(after: WorldState) -> bool:
+        return on_table(relations(after), block) and (accept is None or accept(after))
+
+    spots = nearest_first(grid(*TABLE_INNER, step=0.05), state.pos(block)[:2])
+    return free_spot(state, block, spots, accept=ok)
+
+
+def _flatten(state: WorldState, keep: Iterable[str] = ()) -> tuple[list[Skill], WorldState] | None:
+    """Park, top first, every block that rests on another block (except those in ``keep``)."""
+    keep = set(keep)
+    steps: list[Skill] = []
+    for block in top_first(state, state.blocks):
+        if block in keep or relations(state).below(block) is None:
+            continue
+        step = _park(state, block)
+        if step is None:
+            return None
+        state, failure = apply_skill(state, step)
+        if failure is not None:
+            return None
+        steps.append(step)
+    return steps, state
+
+
+def _greedy(state: WorldState, blocks: list[str], place: Callable[[WorldState, str], Skill | None]) -> list[Skill] | None:
+    """Move ``blocks`` in order, each with the step ``place(current state, block)`` returns."""
+    steps: list[Skill] = []
+    for block in blocks:
+        step = place(state, block)
+        if step is None:
+            return None
+        state, failure = apply_skill(state, step)
+        if failure is not None:
+            return None
+        steps.append(step)
+    return steps
+
+
+def _first_ok(state: WorldState, steps: Iterable[Skill], accept: Callable[[WorldState], bool]) -> Skill | None:
+    """The first step the world model can do whose result ``accept`` likes."""
+    for step in steps:
+        after, failure = apply_skill(state, step)
+        if failure is None and accept(after):
+            return step
+    return None
+
+
+def _next_to_steps(block: str, target: str) -> list[Skill]:
+    return [PutNextTo(block=block, target=target, side=side) for side in SIDES]  # type: ignore[arg-type]
+
+
+def _ring(state: WorldState, centre_of: str, radii: tuple[float, ...] = (0.097, 0.11, 0.125)) -> list[tuple[float, float]]:
+    c = state.pos(centre_of)[:2]
+    return [
+        (float(c[0] + r * np.cos(a)), float(c[1] + r * np.sin(a)))
+        for r in radii
+        for a in np.linspace(0, 2 * np.pi, 24, endpoint=False)
+    ]
+
+
+def _line_plans(
+    state: WorldState,
+    ordered: list[str],
+    axis: int,
+    along: tuple[float, float],
+    across: tuple[float, float],
+    step: float = 0.04,
+) -> Iterator[list[Skill]]:
+    """Plans putting ``ordered`` at explicit points of a straight line through free table space
+    (increasing along ``axis``: 0 = x, 1 = y), lines nearest the table's centre first; the
+    topmost blocks are moved first."""
+    length = ROW_PITCH * (len(ordered) - 1)
+    if along[1] - length < along[0]:
+        return
+
+    def xy(a: float, c: float) -> tuple[float, float]:
+        return (a, c) if axis == 0 else (c, a)
+
+    starts = [(a, c) for a, c in grid((along[0], along[1] - length), across, step=step)]
+    starts.sort(key=lambda ac: float(np.hypot(*(np.array(xy(ac[0] + length / 2, ac[1])) - CENTRE))))
+    for a, c in starts:
+        points = {b: xy(a + i * ROW_PITCH, c) for i, b in enumerate(ordered)}
+        yield [PutAt(block=b, position=points[b]) for b in top_first(state, ordered)]
+
+
+def _components(rel: Relations, members: list[str]) -> list[list[str]]:
+    """Groups of ``members`` linked by next-to relations, largest first."""
+    left, groups = list(members), []
+    while left:
+        group, frontier = [left.pop(0)], None
+        frontier = list(group)
+        while frontier:
+            a = frontier.pop()
+            for b in [b for b in left if rel.is_next_to(a, b)]:
+                left.remove(b)
+                group.append(b)
+                frontier.append(b)
+        groups.append(group)
+    return sorted(groups, key=len, reverse=True)
+
+
+def _blocks_in(rel: Relations, bowl: str) -> list[str]:
+    return [a for a, w in rel.inside if w == bowl]
+
+
+def _nearest(state: WorldState, block: str, names: Iterable[str]) -> list[str]:
+    here = state.pos(block)[:2]
+    return sorted(names, key=lambda n: float(np.hypot(*(state.pos(n)[:2] - here))))
+
+
+def _emptiest_bowls(state: WorldState, rel: Relations, block: str, bowls: Iterable[str]) -> list[str]:
+    here = state.pos(block)[:2]
+    return sorted(bowls, key=lambda w: (len(_blocks_in(rel, w)), float(np.hypot(*(state.pos(w)[:2] - here)))))
+
+
+# --- 1. an ordered row ---------------------------------------------------------------------
+
+
+def _rank(block: str) -> int | None:
+    c = color_of(block)
+    return RAINBOW.index(c) if c in RAINBOW else None
+
+
+class RainbowRow(Intention):
+    name = "dev-rainbow-row"
+    description = (
+        "Line the blocks up in one left-to-right row in rainbow order (red, orange, yellow, "
+        "green, cyan, blue, purple)."
+    )
+    _row = Align()
+
+    def ordered_row(self, state: WorldState, rel: Relations, members: Iterable[str]) -> bool:
+        members = list(members)
+        if not self._row.line_ok(state, rel, members):
+            return False
+        ranks = [_rank(b) for b in sorted(members, key=lambda b: state.pos(b)[0])]
+        return None not in ranks and ranks == sorted(ranks)  # type: ignore[type-var]
+
+    def satisfied(self, state: WorldState) -> bool:
+        return len(state.blocks) >= 2 and self.ordered_row(state, relations(state), state.blocks)
+
+    def score(self, state: WorldState) -> float:
+        n = len(state.blocks)
+        if not n:
+            return 0.0
+        rel = relations(state)
+        flat = [b for b in state.blocks if on_table(rel, b) and _rank(b) is not None]
+        for size in range(len(flat), 1, -1):
+            if any(self.ordered_row(state, rel, c) for c in combinations(flat, size)):
+                return size / n
+        return (1 if flat else 0) / n
+
+    def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
+        if self.score(after) < self.score(before) - 1e-9:
+            return True
+        rel, block = relations(after), step.block
+        if block not in after.blocks:
+            return False
+        if not on_table(rel, block):
+            return True
+        # Set in line beside a block it should not be on that side of.
+        for other in after.blocks:
+            if other == block or not on_table(rel, other) or not rel.is_next_to(block, other):
+                continue
+            if abs(after.pos(other)[1] - after.pos(block)[1]) > 0.02:
+                continue
+            if not self.ordered_row(after, rel, [block, other]):
+                return True
+        return False
+
+    def feasible(self, scene: Scene) -> bool:
+        return len(scene.blocks) >= 2 and all(_rank(b) is not None for b in scene.blocks)
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_blocks = 3 + int(rng.integers(0, 2))
+        return _scene(_pick(rng, n_blocks, RAINBOW), _pick(rng, _bowl_count(rng, n_blocks, 1)))
+
+    def plan(self, state: WorldState) -> list[Skill] | None:
+        if not self.feasible(state.scene):
+            return None
+        if self.satisfied(state):
+            return []
+        ordered = sorted(state.blocks, key=lambda b: _rank(b) or 0)
+
+        def chains() -> Iterator[list[Skill]]:
+            # Keep the first block where it stands and chain the others to its right, or keep
+            # the last and chain the others to its left.
+            yield [PutNextTo(block=b, target=a, side="right") for a, b in zip(ordered, ordered[1:], strict=False)]
+            rev = ordered[::-1]
+            yield [PutNextTo(block=b, target=a, side="left") for a, b in zip(rev, rev[1:], strict=False)]
+
+        (x0, x1), (y0, y1) = TABLE_INNER
+        return _first_verified(self, state, [*chains(), *_line_plans(state, ordered, 0, (x0, x1), (y0, y1))])
+
+
+# --- 2. an ordered tower -------------------------------------------------------------------
+
+
+class CoolUnderWarmTower(Intention):
+    name = "dev-tower-cool-under-warm"
+    description = (
+        "Stack all the blocks into one tower with the cool-coloured blocks at the bottom and "
+        "the warm-coloured blocks on top."
+    )
+
+    @staticmethod
+    def good_part(state: WorldState, tower: list[str]) -> list[str]:
+        """The part of ``tower`` from its base that can grow into the wanted tower."""
+        if any(not is_warm(b) for b in state.blocks) and is_warm(tower[0]):
+            return []  # a warm block at the base while cool blocks exist
+        part, seen_warm = [], False
+        for b in tower:
+            if is_warm(b):
+                seen_warm = True
+            elif seen_warm:
+                break
+            part.append(b)
+        return part
+
+    def satisfied(self, state: WorldState) -> bool:
+        ts = towers(state, relations(state))
+        return len(ts) == 1 and len(state.blocks) >= 2 and self.good_part(state, ts[0]) == ts[0]
+
+    def score(self, state: WorldState) -> float:
+        n = len(state.blocks)
+        if not n:
+            return 0.0
+        return max(len(self.good_part(state, t)) for t in towers(state, relations(state))) / n
+
+    def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
+        if self.score(after) < self.score(before) - 1e-9:
+            return True
+        if step.block not in after.blocks:
+            return False
+        rel = relations(after)
+        tower = next(t for t in towers(after, rel) if step.block in t)
+        part = self.good_part(after, tower)
+        return len(part) < 2 or step.block not in part
+
+    def feasible(self, scene: Scene) -> bool:
+        return any(is_warm(b) for b in scene.blocks) and any(not is_warm(b) for b in scene.blocks)
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_warm, n_cool = [(1, 1), (1, 2), (2, 1), (2, 2)][int(rng.integers(0, 4))]
+        blocks = _warm_and_cool(rng, n_warm, n_cool)
+        return _scene(blocks, _pick(rng, _bowl_count(rng, len(blocks))))
+
+    def plan(self, state: WorldState) -> list[Skill] | None:
+        if not self.feasible(state.scene):
+            return None
+        if self.satisfied(state):
+            return []
+
+        def build(start: WorldState, keep: list[str], prefix: list[Skill]) -> list[Skill]:
+            rest = [b for b in start.blocks if b not in keep]
+            order = [b for b in rest if not is_warm(b)] + [b for b in rest if is_warm(b)]
+            steps, top = list(prefix), keep[-1]
+            for b in order:
+                steps.append(PutOn(block=b, target=top))
+                top = b
+            return steps
+
+        def candidates() -> Iterator[list[Skill]]:
+            rel = relations(state)
+            for tower in towers(state, rel):
+                keep = self.good_part(state, tower)
+                cool_left = any(not is_warm(b) and b not in keep for b in state.blocks)
+                if keep and cool_left and any(is_warm(b) for b in keep):
+                    keep = [b for b in keep if not is_warm(b)]
+                if not keep:
+                    continue
+                flat = _flatten(state, keep)
+                if flat is not None:
+                    yield build(flat[1], keep, flat[0])
+            flat = _flatten(state)
+            if flat is not None:
+                steps, flat_state = flat
+                for base in (b for b in flat_state.blocks if not is_warm(b)):
+                    yield build(flat_state, [base], steps)
+
+        return _first_verified(self, state, candidates())
+
+
+# --- 3–5. table regions -------------------------------------------------------------------
+
+
+class BlocksInMiddle(BlockwiseIntention):
+    name = "dev-blocks-to-the-middle"
+    description = "Move all the blocks to the middle of the table."
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        return rel.table_position[block] == "middle"
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        def ok(after: WorldState) -> bool:
+            return self.wanted(after, relations(after), block)
+
+        spots = nearest_first(grid((-0.09, 0.09), (-0.59, -0.41), step=0.02), CENTRE)
+        if step := free_spot(state, block, spots, accept=ok):
+            return step
+        onto = [PutOn(block=block, target=b) for b in state.blocks
+                if b != block and self.wanted(state, rel, b) and is_clear(rel, b)]
+        into = [PutIn(block=block, bowl=w) for w in state.bowls if rel.table_position[w] == "middle"]
+        return _first_ok(state, onto + into, ok)
+
+    def feasible(self, scene: Scene) -> bool:
+        return len(scene.blocks) >= 1
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_blocks = 2 + int(rng.integers(0, 3))
+        return _scene(_pick(rng, n_blocks), _pick(rng, _bowl_count(rng, n_blocks)))
+
+
+class BlocksToFront(BlockwiseIntention):
+    name = "dev-blocks-to-the-front"
+    description = "Bring all the blocks to the front of the table (the bottom third), none of them in a bowl."
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        return rel.in_bowl(block) is None and rel.table_position[block].startswith("bottom")
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        def ok(after: WorldState) -> bool:
+            return self.wanted(after, relations(after), block)
+
+        here = state.pos(block)[:2]
+        spots = nearest_first(grid((-0.28, 0.28), (-0.78, -0.62), step=0.03), np.array([here[0], -0.7]))
+        if step := free_spot(state, block, spots, accept=ok):
+            return step
+        onto = [PutOn(block=block, target=b) for b in state.blocks
+                if b != block and self.wanted(state, rel, b) and is_clear(rel, b)]
+        return _first_ok(state, onto, ok)
+
+    def feasible(self, scene: Scene) -> bool:
+        return len(scene.blocks) >= 1
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_blocks = 2 + int(rng.integers(0, 3))
+        return _scene(_pick(rng, n_blocks), _pick(rng, _bowl_count(rng, n_blocks)))
+
+
+def _corner_cell(corner: str) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Points whose block stands in the corner's 20 cm cell (2 cm inside its edges)."""
+    xs = (-0.28, -0.12) if "left" in corner else (0.12, 0.28)
+    ys = (-0.38, -0.22) if corner.startswith("top") else (-0.78, -0.62)
+    return xs, ys
+
+
+class OneCorner(Intention):
+    name = "dev-gather-in-one-corner"
+    description = "Gather all the blocks together in one corner of the table, whichever corner you like."
+
+    @staticmethod
+    def counts(state: WorldState, rel: Relations) -> dict[str, int]:
+        return {c: sum(rel.table_position[b] == c for b in state.blocks) for c in CORNERS}
+
+    def satisfied(self, state: WorldState) -> bool:
+        n = len(state.blocks)
+        return n >= 1 and max(self.counts(state, relations(state)).values()) == n
+
+    def score(self, state: WorldState) -> float:
+        n = len(state.blocks)
+        return max(self.counts(state, relations(state)).values()) / n if n else 0.0
+
+    def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
+        if self.score(after) < self.score(before) - 1e-9:
+            return True
+        if step.block not in after.blocks:
+            return False
+        rel = relations(after)
+        counts = self.counts(after, rel)
+        return counts.get(rel.table_position[step.block], 0) < max(counts.values())
+
+    def feasible(self, scene: Scene) -> bool:
+        return len(scene.blocks) >= 2
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_blocks = 2 + int(rng.integers(0, 3))
+        return _scene(_pick(rng, n_blocks), _pick(rng, _bowl_count(rng, n_blocks)))
+
+    def plan(self, state: WorldState) -> list[Skill] | None:
+        if len(state.blocks) < 1:
+            return None
+        if self.satisfied(state):
+            return []
+        rel = relations(state)
+        counts = self.counts(state, rel)
+        centroid = np.mean([state.pos(b)[:2] for b in state.blocks], axis=0)
+        order = sorted(CORNERS, key=lambda c: (-counts[c], float(np.hypot(*(np.array(TABLE_POSITIONS[c]) - centroid)))))
+
+        def into(corner: str) -> Callable[[WorldState, str], Skill | None]:
+            def place(current: WorldState, block: str) -> Skill | None:
+                r = relations(current)
+
+                def ok(after: WorldState) -> bool:
+                    return relations(after).table_position[block] == corner
+
+                spots = [corner, *nearest_first(grid(*_corner_cell(corner), step=0.03), np.array(TABLE_POSITIONS[corner]))]
+                if step := free_spot(current, block, spots, accept=ok):
+                    return step
+                onto = [PutOn(block=block, target=b) for b in current.blocks
+                        if b != block and r.table_position[b] == corner and is_clear(r, b)]
+                bowls = [PutIn(block=block, bowl=w) for w in current.bowls if r.table_position[w] == corner]
+                return _first_ok(current, onto + bowls, ok)
+
+            return place
+
+        def candidates() -> Iterator[list[Skill] | None]:
+            for corner in order:
+                movers = top_first(state, [b for b in state.blocks if rel.table_position[b] != corner])
+                yield _greedy(state, movers, into(corner))
+
+        return _first_verified(self, state, candidates())
+
+
+# --- 6–9. bowls: counts, colours, an exception ---------------------------------------------
+
+
+class AtMostTwoPerBowl(BlockwiseIntention):
+    name = "dev-at-most-two-per-bowl"
+    description = "Put every block in a bowl, with no more than two blocks in any one bowl."
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        bowl = rel.in_bowl(block)
+        return bowl is not None and len(_blocks_in(rel, bowl)) <= 2
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        room = [w for w in state.bowls if len(_blocks_in(rel, w)) < 2 and rel.in_bowl(block) != w]
+        best = _emptiest_bowls(state, rel, block, room)
+        return PutIn(block=block, bowl=best[0]) if best else None
+
+    def feasible(self, scene: Scene) -> bool:
+        return 1 <= len(scene.blocks) <= 2 * len(scene.bowls)
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_blocks, n_bowls = [(3, 2), (3, 2), (3, 2), (2, 1)][int(rng.integers(0, 4))]
+        colors = _pick(rng, n_blocks + n_bowls)
+        return _scene(colors[:n_blocks], colors[n_blocks:])
+
+
+class SameWarmthBowls(BlockwiseIntention):
+    name = "dev-warm-to-warm-bowls"
+    description = (
+        "Put each warm-coloured block in a warm-coloured bowl and each cool-coloured block in a "
+        "cool-coloured bowl."
+    )
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        bowl = rel.in_bowl(block)
+        return bowl is not None and is_warm(bowl) == is_warm(block)
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        best = _emptiest_bowls(state, rel, block, [w for w in state.bowls if is_warm(w) == is_warm(block)])
+        return PutIn(block=block, bowl=best[0]) if best else None
+
+    def feasible(self, scene: Scene) -> bool:
+        return len(scene.blocks) >= 1 and all(
+            any(is_warm(w) == is_warm(b) for w in scene.bowls) for b in scene.blocks
+        )
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_warm, n_cool = [(1, 1), (2, 1), (1, 2)][int(rng.integers(0, 3))]
+        blocks = _warm_and_cool(rng, n_warm, n_cool)
+        bowls = _pick(rng, 1, WARM_COLORS) + _pick(rng, 1, COOL_COLORS)
+        rng.shuffle(bowls)
+        return _scene(blocks, bowls)
+
+
+class AllInBowlsButRed(BlockwiseIntention):
+    name = "dev-bowls-except-red"
+    description = "Put all the blocks in bowls except the red block, which stays on the table."
+
+    @staticmethod
+    def is_red(block: str) -> bool:
+        return color_of(block) == "red"
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        return on_table(rel, block) if self.is_red(block) else rel.in_bowl(block) is not None
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        if self.is_red(block):
+            return self.park(state, block)
+        best = _emptiest_bowls(state, rel, block, state.bowls)
+        return PutIn(block=block, bowl=best[0]) if best else None
+
+    def feasible(self, scene: Scene) -> bool:
+        return "red block" in scene.blocks and len(scene.blocks) >= 2 and len(scene.bowls) >= 1
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        others = _pick(rng, 1 + int(rng.integers(0, 2)), exclude=["red"])
+        blocks = ["red", *others]
+        rng.shuffle(blocks)
+        return _scene(blocks, _pick(rng, 1 + int(rng.integers(0, 5 - len(blocks)))))
+
+
+class MatchingBowlsRestStay(BlockwiseIntention):
+    name = "dev-matching-bowls-rest-stay"
+    description = (
+        "Put each block that has a bowl of its own colour into that bowl, and leave the other "
+        "blocks on the table."
+    )
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        own = f"{color_of(block)} bowl"
+        return rel.in_bowl(block) == own if own in state.positions else on_table(rel, block)
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        own = f"{color_of(block)} bowl"
+        return PutIn(block=block, bowl=own) if own in state.positions else self.park(state, block)
+
+    def feasible(self, scene: Scene) -> bool:
+        return any(f"{color_of(b)} bowl" in scene.bowls for b in scene.blocks)
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_blocks = 2 + int(rng.integers(0, 2))
+        blocks = _pick(rng, n_blocks)
+        n_matched = 1 + int(n_blocks == 3 and rng.random() < 0.4)
+        bowls = blocks[:n_matched]
+        if n_blocks + len(bowls) < 5 and rng.random() < 0.5:
+            bowls += _pick(rng, 1, exclude=blocks)  # a bowl no block matches
+        rng.shuffle(bowls)
+        return _scene(blocks, bowls)
+
+
+# --- 10. stacking with a colour condition ---------------------------------------------------
+
+
+class WarmOnCool(BlockwiseIntention):
+    name = "dev-warm-on-cool"
+    description = "Put each warm-coloured block on top of a cool-coloured block."
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        if not is_warm(block):
+            return True
+        below = rel.below(block)
+        return below is not None and not is_warm(below)
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        cool = [b for b in state.blocks if not is_warm(b) and is_clear(rel, b)]
+        cool.sort(key=lambda b: (not on_table(rel, b), float(np.hypot(*(state.pos(b)[:2] - state.pos(block)[:2])))))
+        return PutOn(block=block, target=cool[0]) if cool else None
+
+    def feasible(self, scene: Scene) -> bool:
+        warm = sum(is_warm(b) for b in scene.blocks)
+        return 1 <= warm <= len(scene.blocks) - warm
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_warm, n_cool = [(1, 1), (1, 2), (1, 3), (2, 2)][int(rng.integers(0, 4))]
+        blocks = _warm_and_cool(rng, n_warm, n_cool)
+        return _scene(blocks, _pick(rng, _bowl_count(rng, len(blocks))))
+
+
+# --- 11. a group --------------------------------------------------------------------------
+
+
+class BlocksTogether(Intention):
+    name = "dev-blocks-together"
+    description = "Gather all the blocks into one group on the table, each block right next to at least one other."
+
+    @staticmethod
+    def groups(state: WorldState, rel: Relations) -> list[list[str]]:
+        return _components(rel, [b for b in state.blocks if on_table(rel, b)])
+
+    def satisfied(self, state: WorldState) -> bool:
+        groups = self.groups(state, relations(state))
+        return len(state.blocks) >= 2 and len(groups) == 1 and len(groups[0]) == len(state.blocks)
+
+    def score(self, state: WorldState) -> float:
+        n = len(state.blocks)
+        groups = self.groups(state, relations(state))
+        return len(groups[0]) / n if n and groups else 0.0
+
+    def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
+        if self.score(after) < self.score(before) - 1e-9:
+            return True
+        rel, block = relations(after), step.block
+        if block not in after.blocks:
+            return False
+        if not on_table(rel, block):
+            return True
+        return not any(rel.is_next_to(block, b) for b in after.blocks if b != block and on_table(rel, b))
+
+    def feasible(self, scene: Scene) -> bool:
+        return len(scene.blocks) >= 2
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_blocks = 3 + int(rng.integers(0, 2))
+        return _scene(_pick(rng, n_blocks), _pick(rng, _bowl_count(rng, n_blocks)))
+
+    def plan(self, state: WorldState) -> list[Skill] | None:
+        if len(state.blocks) < 2:
+            return None
+        if self.satisfied(state):
+            return []
+
+        def candidates() -> Iterator[list[Skill] | None]:
+            flat = _flatten(state)
+            if flat is None:
+                return
+            prefix, start = flat
+            rel = relations(start)
+            groups = self.groups(start, rel)
+            flat_blocks = [b for b in start.blocks if on_table(rel, b)]
+            anchors = [groups[0]] + [[b] for b in _nearest_to_centre(start, flat_blocks)] if groups else [[]]
+            for group in anchors:
+                steps, current, members = list(prefix), start, list(group)
+                movers = top_first(current, [b for b in current.blocks if b not in members])
+                if not members:  # nothing on the table: bring one block out first
+                    first = movers.pop(0)
+                    step = _park(current, first)
+                    if step is None:
+                        continue
+                    current, _ = apply_skill(current, step)
+                    steps.append(step)
+                    members = [first]
+                for b in movers:
+
+                    def ok(after: WorldState, b: str = b, members: list[str] = members) -> bool:
+                        r = relations(after)
+                        return on_table(r, b) and any(r.is_next_to(b, m) for m in members)
+
+                    tries = [s for m in _nearest(current, b, members) for s in _next_to_steps(b, m)]
+                    step = _first_ok(current, tries, ok)
+                    if step is None:
+                        break
+                    current, _ = apply_skill(current, step)
+                    steps.append(step)
+                    members.append(b)
+                else:
+                    yield steps
+
+        return _first_verified(self, state, candidates())
+
+
+def _nearest_to_centre(state: WorldState, blocks: list[str]) -> list[str]:
+    return sorted(blocks, key=lambda b: float(np.hypot(*(state.pos(b)[:2] - CENTRE))))
+
+
+# --- 12–14. next to and in front of bowls ----------------------------------------------------
+
+
+class AroundOneBowl(BlockwiseIntention):
+    name = "dev-blocks-around-a-bowl"
+    description = "Put all the blocks on the table around one bowl, each of them right next to that bowl."
+
+    @staticmethod
+    def target(state: WorldState, rel: Relations) -> str | None:
+        """The bowl with the most blocks next to it (ties: the first listed)."""
+        if not state.bowls:
+            return None
+
+        def count(w: str) -> int:
+            return sum(on_table(rel, b) and rel.is_next_to(b, w) for b in state.blocks)
+
+        return max(state.bowls, key=lambda w: (count(w), -state.bowls.index(w)))
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        bowl = self.target(state, rel)
+        return bowl is not None and on_table(rel, block) and rel.is_next_to(block, bowl)
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        bowl = self.target(state, rel)
+        return self.place_at(state, block, bowl) if bowl else None
+
+    @staticmethod
+    def place_at(state: WorldState, block: str, bowl: str) -> Skill | None:
+        def ok(after: WorldState) -> bool:
+            r = relations(after)
+            return on_table(r, block) and r.is_next_to(block, bowl)
+
+        if step := _first_ok(state, _next_to_steps(block, bowl), ok):
+            return step
+        return free_spot(state, block, nearest_first(_ring(state, bowl), state.pos(block)[:2]), accept=ok)
+
+    def feasible(self, scene: Scene) -> bool:
+        return 1 <= len(scene.blocks) <= 4 and len(scene.bowls) >= 1
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_blocks = 2 + int(rng.integers(0, 2))
+        colors = _pick(rng, n_blocks + 1 + int(rng.integers(0, 2)))
+        return _scene(colors[:n_blocks], colors[n_blocks:])
+
+    def plan(self, state: WorldState) -> list[Skill] | None:
+        if not state.blocks or not state.bowls:
+            return None
+        if self.satisfied(state):
+            return []
+        rel = relations(state)
+
+        def count(w: str) -> int:
+            return sum(on_table(rel, b) and rel.is_next_to(b, w) for b in state.blocks)
+
+        def candidates() -> Iterator[list[Skill] | None]:
+            for bowl in sorted(state.bowls, key=lambda w: -count(w)):  # stable: ties as `target`
+                movers = top_first(state, [b for b in state.blocks
+                                           if not (on_table(rel, b) and rel.is_next_to(b, bowl))])
+                yield _greedy(state, movers, lambda s, b, bowl=bowl: self.place_at(s, b, bowl))
+            yield BlockwiseIntention.plan(self, state)
+
+        return _first_verified(self, state, candidates())
+
+
+class InFrontOfBowls(BlockwiseIntention):
+    name = "dev-blocks-in-front-of-bowls"
+    description = "Put each block on the table right in front of a different bowl."
+
+    @staticmethod
+    def fronts(state: WorldState, rel: Relations, block: str) -> list[str]:
+        """Bowls that ``block`` stands right in front of (closer to the front edge, beside it)."""
+        if not on_table(rel, block):
+            return []
+        p = state.pos(block)
+        return [w for w in state.bowls
+                if rel.is_next_to(block, w) and p[1] < state.pos(w)[1]
+                and abs(p[0] - state.pos(w)[0]) <= FRONT_TOLERANCE]
+
+    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
+        taken = {w for b in state.blocks if b != block for w in self.fronts(state, rel, b)}
+        return any(w not in taken for w in self.fronts(state, rel, block))
+
+    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
+        taken = {w for b in state.blocks if b != block for w in self.fronts(state, rel, b)}
+
+        def ok(after: WorldState) -> bool:
+            r = relations(after)
+            return self.wanted(after, r, block) and all(
+                self.wanted(after, r, b) for b in after.blocks if b != block and self.wanted(state, rel, b)
+            )
+
+        for bowl in _nearest(state, block, [w for w in state.bowls if w not in taken]):
+            c = state.pos(bowl)[:2]
+            spots = [(float(c[0] + dx), float(c[1] - dy)) for dy in (0.097, 0.105, 0.115, 0.125)
+                     for dx in (0.0, -0.02, 0.02, -0.04, 0.04, -0.05, 0.05)]
+            if step := _first_ok(state, [PutNextTo(block=block, target=bowl, side="front")], ok):
+                return step
+            if step := free_spot(state, block, spots, accept=ok):
+                return step
+        return None
+
+    def feasible(self, scene: Scene) -> bool:
+        return 1 <= len(scene.blocks) <= len(scene.bowls)
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        colors = _pick(rng, 4 + int(rng.integers(0, 2)))
+        return _scene(colors[:2], colors[2:])
+
+
+class TowerBesideBowl(Intention):
+    name = "dev-tower-beside-a-bowl"
+    description = "Stack all the blocks into one tower standing on the table right next to a bowl."
+
+    @staticmethod
+    def good(state: WorldState, rel: Relations, tower: list[str]) -> bool:
+        base = tower[0]
+        return on_table(rel, base) and any(rel.is_next_to(base, w) for w in state.bowls)
+
+    def satisfied(self, state: WorldState) -> bool:
+        rel = relations(state)
+        ts = towers(state, rel)
+        return len(state.blocks) >= 2 and len(ts) == 1 and self.good(state, rel, ts[0])
+
+    def score(self, state: WorldState) -> float:
+        n = len(state.blocks)
+        if not n:
+            return 0.0
+        rel = relations(state)
+        return max((len(t) for t in towers(state, rel) if self.good(state, rel, t)), default=0) / n
+
+    def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
+        if self.score(after) < self.score(before) - 1e-9:
+            return True
+        if step.block not in after.blocks:
+            return False
+        rel = relations(after)
+        return not any(step.block in t and self.good(after, rel, t) for t in towers(after, rel))
+
+    def feasible(self, scene: Scene) -> bool:
+        return len(scene.blocks) >= 2 and len(scene.bowls) >= 1
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_blocks = 2 + int(rng.integers(0, 2))
+        colors = _pick(rng, n_blocks + 1 + int(rng.integers(0, 2)))
+        return _scene(colors[:n_blocks], colors[n_blocks:])
+
+    def plan(self, state: WorldState) -> list[Skill] | None:
+        if not self.feasible(state.scene):
+            return None
+        if self.satisfied(state):
+            return []
+
+        def stack_on(start: WorldState, keep: list[str], prefix: list[Skill]) -> list[Skill]:
+            steps, top = list(prefix), keep[-1]
+            for b in top_first(start, [b for b in start.blocks if b not in keep]):
+                steps.append(PutOn(block=b, target=top))
+                top = b
+            return steps
+
+        def candidates() -> Iterator[list[Skill] | None]:
+            rel = relations(state)
+            for tower in towers(state, rel):
+                if self.good(state, rel, tower) and (flat := _flatten(state, tower)) is not None:
+                    yield stack_on(flat[1], tower, flat[0])
+            flat = _flatten(state)
+            if flat is None:
+                return
+            prefix, start = flat
+            near = sorted(start.blocks, key=lambda b: min(float(np.hypot(*(start.pos(b)[:2] - start.pos(w)[:2])))
+                                                           for w in start.bowls))
+            for base in near:
+                for bowl in _nearest(start, base, start.bowls):
+                    step = AroundOneBowl.place_at(start, base, bowl)
+                    if step is not None:
+                        after, _ = apply_skill(start, step)
+                        yield stack_on(after, [base], [*prefix, step])
+
+        return _first_verified(self, state, candidates())
+
+
+# --- 15. a line in a region ------------------------------------------------------------------
+
+
+LEFT_CELLS = ("top left corner", "left side", "bottom left corner")
+
+
+class LeftEdgeColumn(Intention):
+    name = "dev-column-along-left-edge"
+    description = "Line the blocks up front to back in one straight column along the left edge of the table."
+    _column = AlignVertical()
+
+    def column_ok(self, state: WorldState, rel: Relations, members: Iterable[str]) -> bool:
+        members = list(members)
+        return all(rel.table_position[b] in LEFT_CELLS for b in members) and self._column.line_ok(state, rel, members)
+
+    def satisfied(self, state: WorldState) -> bool:
+        return len(state.blocks) >= 2 and self.column_ok(state, relations(state), state.blocks)
+
+    def score(self, state: WorldState) -> float:
+        n = len(state.blocks)
+        if not n:
+            return 0.0
+        rel = relations(state)
+        flat = [b for b in state.blocks if on_table(rel, b) and rel.table_position[b] in LEFT_CELLS]
+        for size in range(len(flat), 1, -1):
+            if any(self.column_ok(state, rel, c) for c in combinations(flat, size)):
+                return size / n
+        return (1 if flat else 0) / n
+
+    def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
+        if self.score(after) < self.score(before) - 1e-9:
+            return True
+        if step.block not in after.blocks:
+            return False
+        rel = relations(after)
+        return not on_table(rel, step.block) or rel.table_position[step.block] not in LEFT_CELLS
+
+    def feasible(self, scene: Scene) -> bool:
+        return 2 <= len(scene.blocks) <= 4
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_blocks = 2 + int(rng.integers(0, 3))
+        return _scene(_pick(rng, n_blocks), _pick(rng, _bowl_count(rng, n_blocks)))
+
+    def plan(self, state: WorldState) -> list[Skill] | None:
+        if len(state.blocks) < 2:
+            return None
+        if self.satisfied(state):
+            return []
+        rel = relations(state)
+
+        def chains() -> Iterator[list[Skill]]:
+            anchors = [b for b in state.blocks if on_table(rel, b) and rel.table_position[b] in LEFT_CELLS]
+            for anchor in anchors:
+                others = top_first(state, [b for b in state.blocks if b != anchor])
+                for side in ("behind", "front"):
+                    steps: list[Skill] = []
+                    prev = anchor
+                    for b in others:
+                        steps.append(PutNextTo(block=b, target=prev, side=side))  # type: ignore[arg-type]
+                        prev = b
+                    yield steps
+
+        ordered = sorted(state.blocks, key=lambda b: state.pos(b)[1])
+        (_, _), (y0, y1) = TABLE_INNER
+        lines = _line_plans(state, ordered, 1, (y0, y1), (-0.28, -0.12), step=0.02)
+        return _first_verified(self, state, [*chains(), *lines])
+
+
+# --- 16. two groups ---------------------------------------------------------------------------
+
+
+class WarmAndCoolGroups(Intention):
+    name = "dev-warm-and-cool-groups"
+    description = (
+        "Make two separate groups of blocks on the table, the warm-coloured blocks together in "
+        "one and the cool-coloured blocks together in the other."
+    )
+
+    @staticmethod
+    def valid(state: WorldState, rel: Relations, block: str) -> bool:
+        """On the table and not touching a block of the other kind."""
+        return on_table(rel, block) and not any(
+            rel.is_next_to(block, b) for b in state.blocks if is_warm(b) != is_warm(block)
+        )
+
+    def groups(self, state: WorldState, rel: Relations, warm: bool) -> list[list[str]]:
+        members = [b for b in state.blocks if is_warm(b) == warm and self.valid(state, rel, b)]
+        return _components(rel, members)
+
+    def _score(self, state: WorldState, rel: Relations) -> int:
+        return sum(len(g[0]) if (g := self.groups(state, rel, warm)) else 0 for warm in (True, False))
+
+    def satisfied(self, state: WorldState) -> bool:
+        return len(state.blocks) >= 2 and self._score(state, relations(state)) == len(state.blocks)
+
+    def score(self, state: WorldState) -> float:
+        n = len(state.blocks)
+        return self._score(state, relations(state)) / n if n else 0.0
+
+    def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
+        if self.score(after) < self.score(before) - 1e-9:
+            return True
+        rel, block = relations(after), step.block
+        if block not in after.blocks:
+            return False
+        if not self.valid(after, rel, block):
+            return True
+        kin = [b for b in after.blocks if b != block and is_warm(b) == is_warm(block)]
+        return bool(kin) and not any(rel.is_next_to(block, b) for b in kin)
+
+    def feasible(self, scene: Scene) -> bool:
+        warm = sum(is_warm(b) for b in scene.blocks)
+        return len(scene.blocks) >= 3 and 1 <= warm < len(scene.blocks)
+
+    def sample_scene(self, rng: np.random.Generator) -> Scene:
+        n_warm, n_cool = [(2, 2), (2, 2), (2, 1), (1, 2)][int(rng.integers(0, 4))]
+        blocks = _warm_and_cool(rng, n_warm, n_cool)
+        return _scene(blocks, _pick(rng, _bowl_count(rng, len(blocks))))
+
+    def plan(self, state: WorldState) -> list[Skill] | None:
+        if not self.feasible(state.scene):
+            return None
+        if self.satisfied(state):
+            return []
+
+        def candidates() -> Iterator[list[Skill] | None]:
+            flat = _flatten(state)
+            if flat is None:
+                return
+            steps, current = list(flat[0]), flat[1]
+            rel = relations(current)
+            keep = {warm: (g[0] if (g := self.groups(current, rel, warm)) else []) for warm in (True, False)}
+            movers = top_first(current, [b for b in current.blocks if b not in keep[True] + keep[False]])
+            for b in movers:
+                own = keep[is_warm(b)]
+
+                def ok(after: WorldState, b: str = b, own: list[str] = own) -> bool:
+                    r = relations(after)
+                    return self.valid(after, r, b) and (not own or any(r.is_next_to(b, m) for m in own))
+
+                if own:
+                    step = _first_ok(current, [s for m in _nearest(current, b, own) for s in _next_to_steps(b, m)], ok)
+                elif ok(current):  # the first of its kind, already apart from the others
+                    own.append(b)
+                    continue
+                else:  # the first of its kind: anywhere on the table away from the others
+                    step = _park(current, b, accept=ok)
+                if step is None:
+                    return
+                current, _ = apply_skill(current, step)
+                steps.append(step)
+                own.append(b)
+            yield steps
+
+        return _first_verified(self, state, candidates())
+
+
+def dev_intentions() -> list[Intention]:
+    """One fresh instance of every dev intention, in a fixed order."""
+    return [
+        RainbowRow(),
+        CoolUnderWarmTower(),
+        BlocksInMiddle(),
+        BlocksToFront(),
+        OneCorner(),
+        AtMostTwoPerBowl(),
+        SameWarmthBowls(),
+        AllInBowlsButRed(),
+        MatchingBowlsRestStay(),
+        WarmOnCool(),
+        BlocksTogether(),
+        AroundOneBowl(),
+        InFrontOfBowls(),
+        TowerBesideBowl(),
+        LeftEdgeColumn(),
+        WarmAndCoolGroups(),
+    ]
+
