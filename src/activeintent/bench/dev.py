@@ -1,7 +1,9 @@
-"""The dev suite: 16 hidden intentions of the kind people ask a tabletop robot for, used to
+"""The dev suite: 10 hidden intentions of the kind people ask a tabletop robot for, used to
 tune learners (``--suite dev``). The held-out suite is never used for tuning; these were
-written without looking at it. Names start with ``dev-`` so that they can never clash with a
-name of another suite (``suites.resolve`` looks names up across suites).
+written without looking at it. Six first-draft intentions that came close in meaning to
+held-out ones (judged by the project lead from the held-out names) were removed, so the suite
+has 10. Names start with ``dev-`` so that they can never clash with a name of another suite
+(``suites.resolve`` looks names up across suites).
 
 Conventions follow the built-in library: "front" is the bottom side of the table (−y, the
 side a block goes to with "in front of"), "left" is −x, warm / cool colours are
@@ -54,7 +56,6 @@ CENTRE = np.array([0.0, -0.5])
 CORNERS = ("top left corner", "top right corner", "bottom left corner", "bottom right corner")
 RAINBOW = ("red", "orange", "yellow", "green", "cyan", "blue", "purple")
 SIDES = ("nearest", "left", "right", "front", "behind")
-FRONT_TOLERANCE = 0.055  # "right in front of a bowl": block centre at most this far to either side
 
 
 # --- scenes ------------------------------------------------------------------------------
@@ -292,149 +293,7 @@ class RainbowRow(Intention):
         return _first_verified(self, state, [*chains(), *_line_plans(state, ordered, 0, (x0, x1), (y0, y1))])
 
 
-# --- 2. an ordered tower -------------------------------------------------------------------
-
-
-class CoolUnderWarmTower(Intention):
-    name = "dev-tower-cool-under-warm"
-    description = (
-        "Stack all the blocks into one tower with the cool-coloured blocks at the bottom and "
-        "the warm-coloured blocks on top."
-    )
-
-    @staticmethod
-    def good_part(state: WorldState, tower: list[str]) -> list[str]:
-        """The part of ``tower`` from its base that can grow into the wanted tower."""
-        if any(not is_warm(b) for b in state.blocks) and is_warm(tower[0]):
-            return []  # a warm block at the base while cool blocks exist
-        part, seen_warm = [], False
-        for b in tower:
-            if is_warm(b):
-                seen_warm = True
-            elif seen_warm:
-                break
-            part.append(b)
-        return part
-
-    def satisfied(self, state: WorldState) -> bool:
-        ts = towers(state, relations(state))
-        return len(ts) == 1 and len(state.blocks) >= 2 and self.good_part(state, ts[0]) == ts[0]
-
-    def score(self, state: WorldState) -> float:
-        n = len(state.blocks)
-        if not n:
-            return 0.0
-        return max(len(self.good_part(state, t)) for t in towers(state, relations(state))) / n
-
-    def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
-        if self.score(after) < self.score(before) - 1e-9:
-            return True
-        if step.block not in after.blocks:
-            return False
-        rel = relations(after)
-        tower = next(t for t in towers(after, rel) if step.block in t)
-        part = self.good_part(after, tower)
-        return len(part) < 2 or step.block not in part
-
-    def feasible(self, scene: Scene) -> bool:
-        return any(is_warm(b) for b in scene.blocks) and any(not is_warm(b) for b in scene.blocks)
-
-    def sample_scene(self, rng: np.random.Generator) -> Scene:
-        n_warm, n_cool = [(1, 1), (1, 2), (2, 1), (2, 2)][int(rng.integers(0, 4))]
-        blocks = _warm_and_cool(rng, n_warm, n_cool)
-        return _scene(blocks, _pick(rng, _bowl_count(rng, len(blocks))))
-
-    def plan(self, state: WorldState) -> list[Skill] | None:
-        if not self.feasible(state.scene):
-            return None
-        if self.satisfied(state):
-            return []
-
-        def build(start: WorldState, keep: list[str], prefix: list[Skill]) -> list[Skill]:
-            rest = [b for b in start.blocks if b not in keep]
-            order = [b for b in rest if not is_warm(b)] + [b for b in rest if is_warm(b)]
-            steps, top = list(prefix), keep[-1]
-            for b in order:
-                steps.append(PutOn(block=b, target=top))
-                top = b
-            return steps
-
-        def candidates() -> Iterator[list[Skill]]:
-            rel = relations(state)
-            for tower in towers(state, rel):
-                keep = self.good_part(state, tower)
-                cool_left = any(not is_warm(b) and b not in keep for b in state.blocks)
-                if keep and cool_left and any(is_warm(b) for b in keep):
-                    keep = [b for b in keep if not is_warm(b)]
-                if not keep:
-                    continue
-                flat = _flatten(state, keep)
-                if flat is not None:
-                    yield build(flat[1], keep, flat[0])
-            flat = _flatten(state)
-            if flat is not None:
-                steps, flat_state = flat
-                for base in (b for b in flat_state.blocks if not is_warm(b)):
-                    yield build(flat_state, [base], steps)
-
-        return _first_verified(self, state, candidates())
-
-
-# --- 3–5. table regions -------------------------------------------------------------------
-
-
-class BlocksInMiddle(BlockwiseIntention):
-    name = "dev-blocks-to-the-middle"
-    description = "Move all the blocks to the middle of the table."
-
-    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        return rel.table_position[block] == "middle"
-
-    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
-        def ok(after: WorldState) -> bool:
-            return self.wanted(after, relations(after), block)
-
-        spots = nearest_first(grid((-0.09, 0.09), (-0.59, -0.41), step=0.02), CENTRE)
-        if step := free_spot(state, block, spots, accept=ok):
-            return step
-        onto = [PutOn(block=block, target=b) for b in state.blocks
-                if b != block and self.wanted(state, rel, b) and is_clear(rel, b)]
-        into = [PutIn(block=block, bowl=w) for w in state.bowls if rel.table_position[w] == "middle"]
-        return _first_ok(state, onto + into, ok)
-
-    def feasible(self, scene: Scene) -> bool:
-        return len(scene.blocks) >= 1
-
-    def sample_scene(self, rng: np.random.Generator) -> Scene:
-        n_blocks = 2 + int(rng.integers(0, 3))
-        return _scene(_pick(rng, n_blocks), _pick(rng, _bowl_count(rng, n_blocks)))
-
-
-class BlocksToFront(BlockwiseIntention):
-    name = "dev-blocks-to-the-front"
-    description = "Bring all the blocks to the front of the table (the bottom third), none of them in a bowl."
-
-    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        return rel.in_bowl(block) is None and rel.table_position[block].startswith("bottom")
-
-    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
-        def ok(after: WorldState) -> bool:
-            return self.wanted(after, relations(after), block)
-
-        here = state.pos(block)[:2]
-        spots = nearest_first(grid((-0.28, 0.28), (-0.78, -0.62), step=0.03), np.array([here[0], -0.7]))
-        if step := free_spot(state, block, spots, accept=ok):
-            return step
-        onto = [PutOn(block=block, target=b) for b in state.blocks
-                if b != block and self.wanted(state, rel, b) and is_clear(rel, b)]
-        return _first_ok(state, onto, ok)
-
-    def feasible(self, scene: Scene) -> bool:
-        return len(scene.blocks) >= 1
-
-    def sample_scene(self, rng: np.random.Generator) -> Scene:
-        n_blocks = 2 + int(rng.integers(0, 3))
-        return _scene(_pick(rng, n_blocks), _pick(rng, _bowl_count(rng, n_blocks)))
+# --- 2. a table region --------------------------------------------------------------------
 
 
 def _corner_cell(corner: str) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -511,7 +370,7 @@ class OneCorner(Intention):
         return _first_verified(self, state, candidates())
 
 
-# --- 6–9. bowls: counts, colours, an exception ---------------------------------------------
+# --- 3–4. bowls: counts and colours --------------------------------------------------------
 
 
 class AtMostTwoPerBowl(BlockwiseIntention):
@@ -564,63 +423,7 @@ class SameWarmthBowls(BlockwiseIntention):
         return _scene(blocks, bowls)
 
 
-class AllInBowlsButRed(BlockwiseIntention):
-    name = "dev-bowls-except-red"
-    description = "Put all the blocks in bowls except the red block, which stays on the table."
-
-    @staticmethod
-    def is_red(block: str) -> bool:
-        return color_of(block) == "red"
-
-    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        return on_table(rel, block) if self.is_red(block) else rel.in_bowl(block) is not None
-
-    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
-        if self.is_red(block):
-            return self.park(state, block)
-        best = _emptiest_bowls(state, rel, block, state.bowls)
-        return PutIn(block=block, bowl=best[0]) if best else None
-
-    def feasible(self, scene: Scene) -> bool:
-        return "red block" in scene.blocks and len(scene.blocks) >= 2 and len(scene.bowls) >= 1
-
-    def sample_scene(self, rng: np.random.Generator) -> Scene:
-        others = _pick(rng, 1 + int(rng.integers(0, 2)), exclude=["red"])
-        blocks = ["red", *others]
-        rng.shuffle(blocks)
-        return _scene(blocks, _pick(rng, 1 + int(rng.integers(0, 5 - len(blocks)))))
-
-
-class MatchingBowlsRestStay(BlockwiseIntention):
-    name = "dev-matching-bowls-rest-stay"
-    description = (
-        "Put each block that has a bowl of its own colour into that bowl, and leave the other "
-        "blocks on the table."
-    )
-
-    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        own = f"{color_of(block)} bowl"
-        return rel.in_bowl(block) == own if own in state.positions else on_table(rel, block)
-
-    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
-        own = f"{color_of(block)} bowl"
-        return PutIn(block=block, bowl=own) if own in state.positions else self.park(state, block)
-
-    def feasible(self, scene: Scene) -> bool:
-        return any(f"{color_of(b)} bowl" in scene.bowls for b in scene.blocks)
-
-    def sample_scene(self, rng: np.random.Generator) -> Scene:
-        n_blocks = 2 + int(rng.integers(0, 2))
-        blocks = _pick(rng, n_blocks)
-        n_matched = 1 + int(n_blocks == 3 and rng.random() < 0.4)
-        bowls = blocks[:n_matched]
-        if n_blocks + len(bowls) < 5 and rng.random() < 0.5:
-            bowls += _pick(rng, 1, exclude=blocks)  # a bowl no block matches
-        rng.shuffle(bowls)
-        return _scene(blocks, bowls)
-
-
-# --- 10. stacking with a colour condition ---------------------------------------------------
+# --- 5. stacking with a colour condition ----------------------------------------------------
 
 
 class WarmOnCool(BlockwiseIntention):
@@ -648,7 +451,7 @@ class WarmOnCool(BlockwiseIntention):
         return _scene(blocks, _pick(rng, _bowl_count(rng, len(blocks))))
 
 
-# --- 11. a group --------------------------------------------------------------------------
+# --- 6. a group ---------------------------------------------------------------------------
 
 
 class BlocksTogether(Intention):
@@ -734,7 +537,7 @@ def _nearest_to_centre(state: WorldState, blocks: list[str]) -> list[str]:
     return sorted(blocks, key=lambda b: float(np.hypot(*(state.pos(b)[:2] - CENTRE))))
 
 
-# --- 12–14. next to and in front of bowls ----------------------------------------------------
+# --- 7–8. next to bowls ----------------------------------------------------------------------
 
 
 class AroundOneBowl(BlockwiseIntention):
@@ -796,51 +599,6 @@ class AroundOneBowl(BlockwiseIntention):
             yield BlockwiseIntention.plan(self, state)
 
         return _first_verified(self, state, candidates())
-
-
-class InFrontOfBowls(BlockwiseIntention):
-    name = "dev-blocks-in-front-of-bowls"
-    description = "Put each block on the table right in front of a different bowl."
-
-    @staticmethod
-    def fronts(state: WorldState, rel: Relations, block: str) -> list[str]:
-        """Bowls that ``block`` stands right in front of (closer to the front edge, beside it)."""
-        if not on_table(rel, block):
-            return []
-        p = state.pos(block)
-        return [w for w in state.bowls
-                if rel.is_next_to(block, w) and p[1] < state.pos(w)[1]
-                and abs(p[0] - state.pos(w)[0]) <= FRONT_TOLERANCE]
-
-    def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        taken = {w for b in state.blocks if b != block for w in self.fronts(state, rel, b)}
-        return any(w not in taken for w in self.fronts(state, rel, block))
-
-    def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
-        taken = {w for b in state.blocks if b != block for w in self.fronts(state, rel, b)}
-
-        def ok(after: WorldState) -> bool:
-            r = relations(after)
-            return self.wanted(after, r, block) and all(
-                self.wanted(after, r, b) for b in after.blocks if b != block and self.wanted(state, rel, b)
-            )
-
-        for bowl in _nearest(state, block, [w for w in state.bowls if w not in taken]):
-            c = state.pos(bowl)[:2]
-            spots = [(float(c[0] + dx), float(c[1] - dy)) for dy in (0.097, 0.105, 0.115, 0.125)
-                     for dx in (0.0, -0.02, 0.02, -0.04, 0.04, -0.05, 0.05)]
-            if step := _first_ok(state, [PutNextTo(block=block, target=bowl, side="front")], ok):
-                return step
-            if step := free_spot(state, block, spots, accept=ok):
-                return step
-        return None
-
-    def feasible(self, scene: Scene) -> bool:
-        return 1 <= len(scene.blocks) <= len(scene.bowls)
-
-    def sample_scene(self, rng: np.random.Generator) -> Scene:
-        colors = _pick(rng, 4 + int(rng.integers(0, 2)))
-        return _scene(colors[:2], colors[2:])
 
 
 class TowerBesideBowl(Intention):
@@ -914,7 +672,7 @@ class TowerBesideBowl(Intention):
         return _first_verified(self, state, candidates())
 
 
-# --- 15. a line in a region ------------------------------------------------------------------
+# --- 9. a line in a region -------------------------------------------------------------------
 
 
 LEFT_CELLS = ("top left corner", "left side", "bottom left corner")
@@ -983,7 +741,7 @@ class LeftEdgeColumn(Intention):
         return _first_verified(self, state, [*chains(), *lines])
 
 
-# --- 16. two groups ---------------------------------------------------------------------------
+# --- 10. two groups ---------------------------------------------------------------------------
 
 
 class WarmAndCoolGroups(Intention):
@@ -1076,18 +834,12 @@ def dev_intentions() -> list[Intention]:
     """One fresh instance of every dev intention, in a fixed order."""
     return [
         RainbowRow(),
-        CoolUnderWarmTower(),
-        BlocksInMiddle(),
-        BlocksToFront(),
         OneCorner(),
         AtMostTwoPerBowl(),
         SameWarmthBowls(),
-        AllInBowlsButRed(),
-        MatchingBowlsRestStay(),
         WarmOnCool(),
         BlocksTogether(),
         AroundOneBowl(),
-        InFrontOfBowls(),
         TowerBesideBowl(),
         LeftEdgeColumn(),
         WarmAndCoolGroups(),
