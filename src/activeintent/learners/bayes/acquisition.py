@@ -35,6 +35,30 @@ def with_new_scene(probs: np.ndarray, feasible: np.ndarray, error: float) -> np.
     return np.concatenate([probs * (1 - p_new), p_new], axis=1)
 
 
+class JudgeView:
+    """The judge restricted to hypotheses ``idx`` (the particles acquisition looks at)."""
+
+    def __init__(self, judge: Judge, idx: np.ndarray):
+        self.inner, self.idx, self.size = judge, idx, len(idx)
+
+    def utility(self, state):
+        return self.inner.utility(state)[self.idx]
+
+    def first_away(self, traj):
+        return self.inner.first_away(traj)[self.idx]
+
+
+def particles(weights: np.ndarray, mass: float = 1 - 1e-4, cap: int = 4000) -> np.ndarray:
+    """The most probable hypotheses holding ``mass`` of the belief (at most ``cap``): EIG over
+    them approximates EIG over H (the neglected tail carries < 1 − mass, or is cut at ``cap``)."""
+    if len(weights) <= cap:
+        return np.arange(len(weights))
+    top = np.argpartition(-weights, cap - 1)[:cap]
+    top = top[np.argsort(-weights[top], kind="stable")]
+    n = int(np.searchsorted(np.cumsum(weights[top]), mass * weights.sum())) + 1
+    return np.sort(top[:min(n, cap)])
+
+
 @dataclass
 class Query:
     """The trajectories to show (as plans) and why: the EIG of this query and the best others."""
@@ -59,9 +83,11 @@ def select_query(
     rng: np.random.Generator,
     choose: str = "eig",
     max_queries: int = 700,
+    cap: int = 4000,
 ) -> Query | None:
     """The query (``signal.shows`` distinct outcomes) with the largest EIG; ``choose="random"``
-    picks uniformly among the candidates instead (same planner, same belief update)."""
+    picks uniformly among the candidates instead (same planner, same belief update). EIG is
+    computed over the ``cap`` most probable hypotheses when H is larger (see :func:`particles`)."""
     combos = list(itertools.combinations(range(len(outs)), signal.shows))
     if not combos:
         return None
@@ -71,6 +97,10 @@ def select_query(
     if choose == "random":
         pick = combos[int(rng.integers(len(combos)))]
         return Query([outs[i] for i in pick], float("nan"))
+    if len(weights) > cap:
+        idx = particles(weights, cap=cap)
+        judge, feasible = JudgeView(judge, idx), feasible[idx]  # type: ignore[assignment]
+        weights = weights[idx] / weights[idx].sum()
     gains = np.empty(len(combos))
     for n, combo in enumerate(combos):
         probs = signal.predictive([outs[i].traj for i in combo], judge, model)

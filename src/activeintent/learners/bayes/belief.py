@@ -17,13 +17,17 @@ from activeintent.learners.bayes.hypotheses import Hypothesis
 Prior = Literal["length", "uniform"]
 
 
-def log_prior(hyps: tuple[Hypothesis, ...], prior: Prior = "length") -> np.ndarray:
+def raw_log_prior(hyps: tuple[Hypothesis, ...], prior: Prior = "length") -> np.ndarray:
+    """log P(z) up to one constant: −L(z) ln 2 (length) or 0 (uniform)."""
     if prior == "uniform":
-        lw = np.zeros(len(hyps))
-    elif prior == "length":
-        lw = -np.array([h.bits for h in hyps]) * math.log(2)
-    else:
-        raise ValueError(f"unknown prior {prior!r}; valid priors: length, uniform")
+        return np.zeros(len(hyps))
+    if prior == "length":
+        return -np.array([h.bits for h in hyps]) * math.log(2)
+    raise ValueError(f"unknown prior {prior!r}; valid priors: length, uniform")
+
+
+def log_prior(hyps: tuple[Hypothesis, ...], prior: Prior = "length") -> np.ndarray:
+    lw = raw_log_prior(hyps, prior)
     return lw - np.logaddexp.reduce(lw)
 
 
@@ -33,7 +37,9 @@ class Belief:
     def __init__(self, hyps: tuple[Hypothesis, ...], prior: Prior = "length"):
         self.hyps = hyps
         self.prior = prior
-        self.log_w = log_prior(hyps, prior)
+        raw = raw_log_prior(hyps, prior)
+        self.log_norm = float(np.logaddexp.reduce(raw))  # log Σ_z of the unnormalised prior
+        self.log_w = raw - self.log_norm
         self.log_evidence = 0.0  # log Π_k P(h_k), the normalisers so far
 
     @property
@@ -65,3 +71,17 @@ class Belief:
         self.hyps = self.hyps + tuple(new)
         self.log_w = np.concatenate([old, each + log_lik])
         self.log_w -= np.logaddexp.reduce(self.log_w)
+
+    def extend(self, new: tuple[Hypothesis, ...], log_lik: np.ndarray) -> None:
+        """Add hypotheses with their own prior (same principle, same scale as the others) and
+        their Σ_k log P(h_k | z): the posterior is then exactly the one over the larger space,
+        as if the new z had been enumerated from the start."""
+        if not new:
+            return
+        raw_new = raw_log_prior(new, self.prior)
+        joint = np.concatenate([self.log_w + self.log_evidence + self.log_norm, raw_new + log_lik])
+        self.hyps = self.hyps + tuple(new)
+        self.log_norm = float(np.logaddexp(self.log_norm, np.logaddexp.reduce(raw_new)))
+        total = float(np.logaddexp.reduce(joint))
+        self.log_w = joint - total
+        self.log_evidence = total - self.log_norm

@@ -43,11 +43,15 @@ def candidate_plans(
     explore: int = 6,
     prefixes: bool = True,
     limit: int = 36,
+    feasible: np.ndarray | None = None,
 ) -> list[Outcome]:
-    """Distinct predicted outcomes of the plans of likely (and a few random) hypotheses."""
-    scene = state.scene
+    """Distinct predicted outcomes of the plans of likely (and a few random) hypotheses;
+    ``feasible``: the hypotheses the scene can show (default: asked one by one)."""
+    if feasible is None:
+        scene = state.scene
+        feasible = np.fromiter((h.feasible(scene) for h in hyps), bool, len(hyps))
     order = np.argsort(-weights, kind="stable")
-    feasible = [i for i in order if hyps[i].feasible(scene)]
+    feasible = order[feasible[order]].tolist()
     chosen = feasible[:top_k]
     rest = feasible[top_k:]
     if rest and explore:

@@ -68,6 +68,26 @@ class HypothesisJudge:
         self.size = len(hyps)
         self.token = next(_TOKENS)
         self._away: dict[int, tuple[Trajectory, np.ndarray]] = {}
+        self._feasible: dict[tuple[str, ...], np.ndarray] = {}
+
+    def feasible(self, objects: tuple[str, ...] | list[str]) -> np.ndarray:
+        """Per hypothesis: can a scene of ``objects`` show it? (memoised per scene)"""
+        key = tuple(objects)
+        got = self._feasible.get(key)
+        if got is None:
+            from activeintent.world import Scene
+
+            scene = Scene(objects=list(key))
+            got = np.fromiter((h.feasible(scene) for h in self.hyps), bool, self.size)
+            if len(self._feasible) > 4096:
+                self._feasible.clear()
+            self._feasible[key] = got
+        return got
+
+    def prefetch(self, states: list[Facts]) -> None:
+        """Judge many states at once (hypotheses that run code in a sandbox batch them)."""
+        for h in self.hyps:
+            h.prefetch(states)
 
     def judge(self, f: Facts) -> tuple[np.ndarray, np.ndarray]:
         """(satisfied, score) of the state behind ``f`` under every hypothesis."""

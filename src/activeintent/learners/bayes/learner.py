@@ -143,9 +143,10 @@ class BayesLearner(Learner):
 
     def _select(self, state: WorldState) -> Query | None:
         c = self.config
+        feasible = self.judge.feasible(tuple(state.positions))
         outs = candidate_plans(self.hyps, self.weights, state, self.rng, top_k=c.top_k, explore=c.explore,
-                               prefixes=self.sig.shows > 1, limit=c.max_plans)
-        feasible = np.array([h.feasible(state.scene) for h in self.hyps])
+                               prefixes=self.sig.shows > 1, limit=c.max_plans, feasible=feasible)
+        feasible = self.judge.feasible(tuple(state.positions))  # the planner may have found some z infeasible
         return select_query(self.sig, self.model, self.judge, self.weights, feasible, outs,
                             c.new_scene_error, self.rng, choose=c.choose)
 
@@ -178,7 +179,7 @@ class BayesLearner(Learner):
     # ---- answers ----
 
     def _likelihood(self, obs: Observation, hyps: tuple[Hypothesis, ...], judge_) -> np.ndarray:
-        feasible = np.array([h.feasible(obs.scene) for h in hyps])
+        feasible = judge_.feasible(obs.scene.objects)
         e = self.config.new_scene_error
         if obs.answer.new_scene:
             return np.where(feasible, e, 1 - e)
@@ -209,15 +210,14 @@ class BayesLearner(Learner):
     def final(self, scene: Scene, state: WorldState) -> Estimate:
         """The plan with the largest expected success Σ_z w_z 1[z satisfied by its outcome],
         among the plans of the hypotheses that can be shown in this scene."""
-        feasible = np.array([h.feasible(scene) for h in self.hyps])
+        feasible = self.judge.feasible(scene.objects)
         w = self.weights * feasible
         w = w / w.sum() if w.sum() > 0 else self.weights
         outs = [predict(state, [])] + candidate_plans(
             self.hyps, w, state, self.rng, top_k=self.config.final_top_k, explore=0,
-            prefixes=False, limit=self.config.max_plans)
+            prefixes=False, limit=self.config.max_plans, feasible=feasible)
         finals = [facts(o.traj.outcome) for o in outs]
-        for h in self.hyps:
-            h.prefetch(finals)
+        self.judge.prefetch(finals)
         success = np.array([float(w @ self.judge.judge(f)[0]) for f in finals])
         best = int(np.argmax(success - 1e-6 * np.array([len(o.plan) for o in outs])))
         top = self.hyps[int(np.argmax(w))]

@@ -728,6 +728,7 @@ for _node in (AllBlocks(), ColourBlock(), ColourClass(), BowlMatch(),
 
 # ---- quantifiers ---------------------------------------------------------------------------
 
+MAX_CLAUSES = 3  # a goal is a conjunction of 1–3 clauses
 QUANTS = ("every", "none", "exactly-1", "exactly-2", "at-least-1", "at-least-2")
 NUMBER = {"1": "one", "2": "two"}
 
@@ -952,9 +953,10 @@ class Goal:
 
     @property
     def bits(self) -> float:
-        """1 bit for one/two clauses, 1 bit for the stays flag, the clauses; −1 for two
-        clauses since either order says the same."""
-        return 2 + sum(c.bits for c in self.clauses) - (1 if len(self.clauses) == 2 else 0)
+        """log2(MAX_CLAUSES) for how many clauses, 1 bit for the stays flag, the clauses;
+        − log2(n!) since the clauses' order says nothing."""
+        n = len(self.clauses)
+        return math.log2(MAX_CLAUSES) + 1 + sum(c.bits for c in self.clauses) - math.log2(math.factorial(n))
 
     def sentence(self) -> str:
         parts = [c.sentence() for c in self.clauses]

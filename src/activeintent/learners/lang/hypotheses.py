@@ -84,7 +84,10 @@ class LangHypothesis(Hypothesis):
         self.clauses = ()
         self.bits = goal.bits
         self.name = goal.key
-        self.description = goal.sentence()
+
+    @property
+    def description(self) -> str:  # built when read: a space holds 10^5 goals
+        return self.goal.sentence()
 
     def holds_f(self, f: Facts) -> bool:
         return bool(self.space.compiled.eval(f)[0][self.index])

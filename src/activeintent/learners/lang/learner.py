@@ -1,18 +1,24 @@
 """``lang-<signal>``: the Bayesian active learner over the goal language.
 
 The same learner as ``bayes-<signal>`` (belief, EIG over candidate plans, final answer) with
-the language's hypothesis space, and a judge that scores every goal of the space on a state
-in one numpy pass instead of one Python call per hypothesis.
+the language's hypothesis space, a judge that scores every goal on a state in one numpy pass,
+and a space that grows while it learns (proposals.py): after every answer the neighbours of
+the likely goals, and with ``--llm`` the model's goals in the language, join the belief with
+their prior 2^-L(z) and their likelihood on every answer so far.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from pydantic import Field
 
-from activeintent.learners.bayes.facts import facts
+from activeintent.learners.base import RoundRecord
+from activeintent.learners.bayes.facts import Facts, facts
 from activeintent.learners.bayes.judge import HypothesisJudge, trajectory_steps, utility
 from activeintent.learners.bayes.learner import BayesConfig, BayesLearner
 from activeintent.learners.lang.hypotheses import LangHypothesis, LangSpace, lang_space
+from activeintent.learners.lang.proposals import neighbours, propose_goals
+from activeintent.llm.base import ModelError
 from activeintent.world import WorldState
 from activeintent.world.trajectory import Trajectory
 
@@ -20,14 +26,31 @@ KEEP = 3000  # goals kept after de-duplication (the shortest ones)
 
 
 class LangJudge(HypothesisJudge):
-    """Judges outcomes under every goal of one LangSpace at once."""
+    """Judges outcomes under every goal of one or more LangSpaces at once (vectors concatenated
+    in the order of the spaces)."""
 
-    def __init__(self, space: LangSpace):
-        super().__init__(space.hypotheses)
-        self.compiled = space.compiled
+    def __init__(self, spaces: LangSpace | list[LangSpace]):
+        self.spaces = [spaces] if isinstance(spaces, LangSpace) else list(spaces)
+        super().__init__(tuple(h for sp in self.spaces for h in sp.hypotheses))
+
+    def _cat(self, get) -> np.ndarray:
+        parts = [get(sp) for sp in self.spaces]
+        return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+    def judge(self, f: Facts) -> tuple[np.ndarray, np.ndarray]:
+        if len(self.spaces) == 1:
+            return self.spaces[0].compiled.eval(f)
+        got = [sp.compiled.eval(f) for sp in self.spaces]
+        return np.concatenate([g[0] for g in got]), np.concatenate([g[1] for g in got])
+
+    def feasible(self, objects) -> np.ndarray:
+        return self._cat(lambda sp: sp.feasible(tuple(objects)))
+
+    def prefetch(self, states) -> None:  # the compiled judge needs no batching
+        return None
 
     def utility(self, state: WorldState) -> np.ndarray:
-        holds, score = self.compiled.eval(facts(state))
+        holds, score = self.judge(facts(state))
         return utility(score, holds)
 
     def first_away(self, traj: Trajectory) -> np.ndarray:
@@ -38,31 +61,122 @@ class LangJudge(HypothesisJudge):
         for k, (fb, fa, block, ok) in enumerate(trajectory_steps(traj)):
             if fb is fa:
                 continue
-            _, sb = self.compiled.eval(fb)
-            _, sa = self.compiled.eval(fa)
+            _, sb = self.judge(fb)
+            _, sa = self.judge(fa)
             away = sa < sb - 1e-9
             if ok:
-                away = away | self.compiled.moved_off(fb, fa, block)
+                away = away | self._cat(lambda sp, fb=fb, fa=fa, block=block: sp.compiled.moved_off(fb, fa, block))
             out[(out < 0) & away] = k
             if (out >= 0).all():
                 break
         if len(self._away) > 4096:
             self._away.clear()
-        self._away[id(traj)] = (traj, out)
+        self._away[id(traj)] = (traj, out)  # keeps τ alive so its id is not reused
         return out
 
 
-class LangLearner(BayesLearner):
-    """BayesLearner over the goal language (no model proposals: the language is the space)."""
+class LangConfig(BayesConfig):
+    """The Bayesian learner's settings plus how the space grows (none tuned to intentions)."""
 
-    def __init__(self, signal, rng=None, llm=None, config: BayesConfig | None = None,
+    rejuvenate_top: int = Field(8, ge=0, description="after each answer, neighbours of this many likely goals join")
+    join_partners: int = Field(32, ge=0, description="... and each of them joined with each of this many likely goals")
+    max_added: int = Field(20000, ge=0, description="goals added in one episode at most")
+    proposals_per_call: int = Field(3, ge=1, le=5, description="goals asked of the model per call")
+
+
+class LangLearner(BayesLearner):
+    """BayesLearner over the goal language, with a space that grows around its belief."""
+
+    def __init__(self, signal, rng=None, llm=None, config: LangConfig | None = None,
                  hypotheses: tuple[LangHypothesis, ...] | None = None, keep: int = KEEP):
-        hyps = hypotheses or lang_space(0, keep).hypotheses
-        super().__init__(signal, rng, None, config or BayesConfig(), hyps)
+        hyps = tuple(hypotheses or lang_space(0, keep).hypotheses)
+        config = config or LangConfig()
+        super().__init__(signal, rng, None, config, hyps)
+        self.config: LangConfig = config
+        self.llm = llm
         self.name = f"lang-{self.signal}"
-        spaces = {h.space for h in hyps} if all(isinstance(h, LangHypothesis) for h in hyps) else set()
-        if len(spaces) == 1 and next(iter(spaces)).hypotheses == tuple(hyps):
-            self.judge = LangJudge(next(iter(spaces)))
+        spaces = list(dict.fromkeys(h.space for h in hyps))
+        if tuple(h for sp in spaces for h in sp.hypotheses) != hyps:
+            raise ValueError("lang learner: hypotheses must be whole LangSpaces, in order")
+        self.base = spaces
+        self.added = LangSpace([])  # goals that joined during this episode
+        self.judge = LangJudge(self.base)
+        self.keys = {h.name for h in hyps}
+        self.growth = {"neighbours": 0, "model_answers": 0, "model_fit": 0, "model_new": 0}
+        self.model_goals: set[str] = set()
+
+    # ---- growing the space ----
+
+    def _log_lik(self, judge: HypothesisJudge) -> np.ndarray:
+        total = np.zeros(judge.size)
+        for obs in self.observations:
+            total += np.log(np.clip(self._likelihood(obs, judge.hyps, judge), 1e-300, None))
+        return total
+
+    def _admit(self, goals) -> list[str]:
+        """Add goals not held yet (up to the episode's cap), scored on every answer so far."""
+        room = self.config.max_added - len(self.added.goals)
+        fresh = [g for g in goals if g.key not in self.keys][:max(room, 0)]
+        if not fresh:
+            return []
+        n_old = len(self.added.goals)
+        self.added = LangSpace(list(self.added.goals) + fresh)
+        new_space = LangSpace(fresh)  # scored alone, then merged: the judge below is temporary
+        log_lik = self._log_lik(LangJudge(new_space))
+        self.judge = LangJudge(self.base + [self.added])
+        self.belief.extend(self.added.hypotheses[n_old:], log_lik)
+        self.belief.hyps = self.judge.hyps  # the same goals, bound to the merged space
+        self.keys.update(g.key for g in fresh)
+        return [g.key for g in fresh]
+
+    def _rejuvenate(self) -> int:
+        if not self.config.rejuvenate_top:
+            return 0
+        likely = [h.goal for h, _ in self.top(self.config.join_partners)]  # type: ignore[attr-defined]
+        added = self._admit(neighbours(likely[:self.config.rejuvenate_top], likely))
+        self.growth["neighbours"] += len(added)
+        return len(added)
+
+    def _propose(self) -> list[str]:
+        """Goals in the language from the model (``--llm``), decoded under the language's schema."""
+        self.proposal_calls += 1
+        history = "\n".join(
+            f"{i}. scene: {', '.join(o.scene.objects)}; shown: {'; '.join(o.texts)}; answer: {o.answer.describe()}"
+            for i, o in enumerate(self.observations, 1))
+        likely = [(h.goal, w) for h, w in self.top(5)]  # type: ignore[attr-defined]
+        try:
+            goals, answered = propose_goals(self.llm, likely, history, self.config.proposals_per_call,  # type: ignore[arg-type]
+                                            seed=int(self.rng.integers(2**31)))
+        except ModelError as err:
+            self.proposal_errors.append(str(err)[:300])
+            return []
+        self.growth["model_answers"] += answered
+        self.growth["model_fit"] += len(goals)
+        self.model_goals.update(g.key for g in goals)
+        added = self._admit(goals)
+        self.growth["model_new"] += len(added)
+        return added
+
+    def observe(self, record: RoundRecord, trajectories: list[Trajectory]) -> str | None:
+        out = super().observe(record, trajectories)  # Bayes' rule, then model proposals (if any)
+        if record.answer is not None:
+            n = self._rejuvenate()
+            if self.log:
+                self.log[-1]["neighbours_added"] = n
+        return out
+
+    def stats(self) -> dict:
+        out = super().stats()
+        w = self.weights
+        model = np.array([h.name in self.model_goals for h in self.hyps])
+        out.update(self.growth)
+        out.update({
+            "space_start": sum(len(sp.goals) for sp in self.base),
+            "added_mass": round(float(w[sum(len(sp.goals) for sp in self.base):].sum()), 4),
+            "model_goal_mass": round(float(w[model].sum()), 4) if model.any() else 0.0,
+            "top_is_model_goal": bool(self.top()[0][0].name in self.model_goals),
+        })
+        return out
 
 
 def lang_method(signal: str):
@@ -70,6 +184,6 @@ def lang_method(signal: str):
     from activeintent.learners.registry import LearnerContext, Method
 
     def build(ctx: LearnerContext) -> LangLearner:
-        return LangLearner(signal, rng=ctx.seed, config=BayesConfig(prior=ctx.prior))  # type: ignore[arg-type]
+        return LangLearner(signal, rng=ctx.seed, llm=ctx.llm, config=LangConfig(prior=ctx.prior))  # type: ignore[arg-type]
 
-    return Method(signal, False, build, f"ours: belief over the goal language, {signal} queries by EIG")
+    return Method(signal, False, build, f"ours: growing belief over the goal language, {signal} queries by EIG")

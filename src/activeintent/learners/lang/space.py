@@ -6,8 +6,8 @@ and every unordered pair of the simplest distinct clauses. De-duplication: goals
 a seeded bank of probe scenes — per scene whether the goal can be shown (static check), per
 probe state whether it holds, per probe move whether the move goes against it; goals with the
 same answers everywhere are one (the shortest is kept), goals that hold on no probe state are
-dropped (nothing could confirm them). The shortest distinct one-clause goals (60 %) and
-two-clause goals (40 %) of ``keep`` form the space.
+dropped (nothing could confirm them). The ``keep`` shortest distinct goals form the space
+the learner starts from (it grows while learning: proposals.py).
 The list is cached on disk under ``$ACTIVEINTENT_CACHE`` (default ``~/.cache/activeintent``),
 keyed by a hash of the sources it depends on and of the registered node types.
 """
@@ -15,6 +15,7 @@ keyed by a hash of the sources it depends on and of the registered node types.
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import os
 import time
@@ -30,7 +31,7 @@ from activeintent.learners.lang.planner import generic_moves, plan
 from activeintent.world import WorldState, apply_skill, layout
 from activeintent.world.scene import kind_of
 
-PAIR_SHARE = 0.4  # share of the kept space given to two-clause goals
+_TOKENS = itertools.count()
 Q_CODE = {"every": 0, "none": 1, "exactly": 2, "at-least": 3}
 
 
@@ -73,7 +74,7 @@ class Compiled:
         self.e_n = np.array([int(c.quant[-1]) if c.quant[-1].isdigit() else 0 for c in each], int)
         self.f_sel = np.array([sels[(clauses[i].sel, clauses[i].sp)] for i in self.forms], int)
         self._possible: dict[tuple[str, ...], np.ndarray] = {}
-        self._tag = ("lang", id(self))
+        self._tag = ("lang", next(_TOKENS))  # unique per judge (an id() can be reused)
 
     # -- per state --
 
@@ -318,12 +319,9 @@ def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scen
         generated += len(bs)
     del state_scene
     distinct = sorted(best.values())
-    # The truncation keeps the shortest goals of each size (one clause / two clauses), so that
-    # the space is not only one-clause goals; within the space the prior is still 2^-bits.
-    one = [k for _, k in distinct if " & " not in k.replace(" & stays", "")]
-    two = [k for _, k in distinct if " & " in k.replace(" & stays", "")]
-    n_two = int(keep * PAIR_SHARE)
-    kept = one[:keep - min(n_two, len(two))] + two[:n_two]
+    # The space starts as the ``keep`` shortest distinct goals (most probable first under the
+    # prior); longer ones join while learning (proposals.py).
+    kept = [k for _, k in distinct[:keep]]
     return {"keys": kept, "generated": generated, "clauses": n, "distinct": len(distinct),
             "pair_clauses": len(idx), "probe_scenes": len(scenes), "probe_states": len(states),
             "probe_moves": len(moves), "seconds": round(time.time() - t0, 1)}
