@@ -20,6 +20,10 @@ GOALS = [
     "give each block the bowl of its own colour",
     "match the blocks with the bowls by colour",
 ]
+LANG_GOAL = {"clauses": [{"quantifier": "every", "blocks": "class:warm", "predicate": "in-bowl:other"},
+                         {"quantifier": "every", "blocks": "class:cool", "predicate": "in-bowl:other"},
+                         {"quantifier": "none", "blocks": "all:", "predicate": "on-block:any"}],
+             "others_stay": False}
 PREFERENCES = ["blocks belong with bowls of their colour", "colour decides the bowl", "like goes with like"]
 SCENES = [
     ["red block", "blue block", "red bowl", "blue bowl"],
@@ -93,6 +97,9 @@ class ChatServer:
                 out["goal_a"], out["goal_b"] = rng.sample(GOALS, 2)
                 out["done"] = True  # says it is sure: the benchmark runs K rounds anyway
             return json.dumps(out)
+        if name == "GoalProposals":  # the lang learner: goals in the language (one fits, one does not)
+            return json.dumps({"goals": [LANG_GOAL, {"clauses": [
+                {"quantifier": "form", "blocks": "all:", "predicate": "in-bowl:same"}], "others_stay": False}]})
         if name == "FaithfulRetrieval":
             return json.dumps({"reasoning": "looked", "retrieved": "the person did not like that bowl"})
         raise AssertionError(f"unexpected schema {name}")

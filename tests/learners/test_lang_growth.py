@@ -103,3 +103,54 @@ def test_model_answers_become_goals_only_when_their_parts_fit():
                                                        "predicate": "juggling:yes"}], "others_stay": False}]})
     enum = json.dumps(schema.model_json_schema())
     assert "region:left half" in enum and "form tower:any" in enum
+
+
+def test_model_goals_enter_the_belief_with_prior_and_likelihood_only(tmp_path, monkeypatch):
+    """``--llm`` on a scripted OpenAI-compatible server: the model is asked for goals under the
+    language's schema, the goal that fits joins the belief scored on every answer, the one
+    that does not fit is counted and dropped."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from chat_server import LANG_GOAL, ChatServer, schema_name
+
+    from activeintent.learners.lang.proposals import goals_schema as schema
+    from activeintent.runner import RunOptions, build_episode
+
+    monkeypatch.setenv("OPENAI_API_KEY", "test")
+    with ChatServer() as server:
+        opts = RunOptions(method="lang-stop", intention="color-mismatch", env="symbolic", user="exact",
+                          llm="openai:fake", base_url=server.base_url, cache=str(tmp_path / "c.sqlite"),
+                          budget=4, test_scenes=2, video="none")
+        episode = build_episode(opts, tmp_path / "ep")
+        result = episode.run()
+    asked = [b for b in server.requests if schema_name(b) == "GoalProposals"]
+    assert result.error is None and 1 <= len(asked) <= 3
+    assert "region:left half" in json.dumps(asked[0]["response_format"])  # the language's words are the enum
+    stats = result.learner_stats
+    assert stats["model_answers"] == 2 * len(asked) and stats["model_fit"] == len(asked)
+    learner = episode.learner
+    model_goal = to_goal(schema(3).model_validate({"goals": [LANG_GOAL]}).goals[0])
+    names = [h.name for h in learner.hyps]
+    assert model_goal is not None and model_goal.key in names and stats["model_new"] == 1
+    b = learner.belief
+    i = names.index(model_goal.key)
+    log_lik = b.log_w[i] + learner.hyps[i].bits * np.log(2) + b.log_norm + b.log_evidence
+    assert log_lik == pytest.approx(learner._log_lik(LangJudge(LangSpace([model_goal])))[0])
+
+
+@pytest.mark.slow
+def test_the_embedded_model_proposes_goals_that_parse_under_the_grammar():
+    """The real llama.cpp model decodes under the language's grammar: whatever the small base
+    model writes, every clause's words come from the language."""
+    from activeintent.learners.lang.proposals import propose_goals
+    from activeintent.llm.registry import load_model
+
+    model = load_model("embedded", cache_mode="off")
+    likely = [(Goal((WARM_LEFT,)), 0.4), (Goal((COOL_RIGHT,)), 0.3)]
+    history = "1. scene: red block, blue block, green bowl; shown: step 1: put the red block in the green bowl; answer: stop"
+    goals, answered = propose_goals(model, likely, history, count=2, seed=0)
+    assert 1 <= answered <= 2
+    for g in goals:
+        assert parse_goal(g.key) == g and 1 <= len(g.clauses) <= MAX_CLAUSES
