@@ -25,28 +25,45 @@ def perf_bench(
     episodes: Annotated[int, typer.Option(min=1, help="episodes per setting")] = 3,
     method: Annotated[str, typer.Option("--method")] = "bayes-stop",
     envs: Annotated[str, typer.Option("--envs", help="comma-separated envs")] = "symbolic,pybullet",
+    intentions: Annotated[str, typer.Option("--intentions", help="comma-separated hidden intentions")] = "color-match",
+    budget: Annotated[int, typer.Option(min=1, help="signals per episode")] = 5,
 ) -> None:
-    """Time per phase and per episode of fixed `run`-like episodes (no video, no model)."""
+    """Time per phase and per episode of fixed `run`-like episodes (no video, no model), and the
+    learner's time per signal (choosing the query, reading the answer; scoring excluded)."""
     from activeintent.runner import RunOptions, build_episode
 
-    out: dict = {"method": method, "episodes": episodes, "settings": {}}
+    class RoundTimes:
+        def __init__(self) -> None:
+            self.learner_s: list[float] = []
+
+        def answered(self, log) -> None:
+            self.learner_s.append(log.timing.get("learner_s", 0.0))
+
+    names = [n.strip() for n in intentions.split(",") if n.strip()]
+    out: dict = {"method": method, "episodes": episodes, "intentions": names, "budget": budget, "settings": {}}
     for env in [e.strip() for e in envs.split(",") if e.strip()]:
-        walls, phases = [], []
-        for seed in range(episodes):
-            options = RunOptions(method=method, intention="color-match", env=env, llm="none", video="none", seed=seed)
-            start = time.perf_counter()
-            episode = build_episode(options)
-            try:
-                result = episode.run()
-            finally:
-                episode.env.close()
-            walls.append(time.perf_counter() - start)
-            phases.append(result.time_split)
+        walls, phases, rounds = [], [], RoundTimes()
+        for name in names:
+            for seed in range(episodes):
+                options = RunOptions(method=method, intention=name, env=env, llm="none", video="none", seed=seed,
+                                     budget=budget)
+                start = time.perf_counter()
+                episode = build_episode(options)
+                episode.observers.append(rounds)
+                try:
+                    result = episode.run()
+                finally:
+                    episode.env.close()
+                walls.append(time.perf_counter() - start)
+                phases.append(result.time_split)
         keys = phases[0].keys()
         out["settings"][env] = {
             "episode_s_median": round(statistics.median(walls), 3),
             "episode_s_max": round(max(walls), 3),
             "phase_s_mean": {k: round(statistics.fmean(p[k] for p in phases), 3) for k in keys},
+            "learner_s_per_signal_median": round(statistics.median(rounds.learner_s), 3),
+            "learner_s_per_signal_p90": round(sorted(rounds.learner_s)[int(0.9 * (len(rounds.learner_s) - 1))], 3),
+            "signals": len(rounds.learner_s),
         }
     if as_json:
         typer.echo(json.dumps(out, indent=2))

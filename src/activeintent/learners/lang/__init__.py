@@ -4,5 +4,6 @@
 - planner.py — one planner for every goal, on the symbolic world model;
 - space.py — enumeration, behavioural de-duplication on probe scenes, a vectorised judge;
 - hypotheses.py — goals as hypotheses of the Bayesian learner and as hidden intentions;
+- proposals.py — new goals while learning: neighbours of likely goals, a model's goals;
 - learner.py — ``lang-<signal>``; explain.py — sentences to goals (``hypotheses --explain``).
 """

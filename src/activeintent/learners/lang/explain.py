@@ -106,10 +106,12 @@ def language_summary(examples: int = 12) -> dict:
     goals = goal_space(0, KEEP)
     step = max(1, len(goals) // max(examples, 1))
     return {
-        "grammar": ["goal → clause [& clause] [& every other block stays]",
+        "grammar": ["goal → clause [& clause [& clause]] [& every other block stays]",
                     "clause → quantifier selector relation | structure selector",
                     f"quantifier → {' | '.join(QUANTS)}",
-                    "bits = Σ over nodes log2(choices); prior P(z) ∝ 2^-bits"],
+                    "bits = Σ over nodes log2(choices); prior P(z) ∝ 2^-bits",
+                    f"the learner starts from the {KEEP} shortest distinct goals; after each answer "
+                    "neighbours of its likely goals (and with --llm a model's goals) join the belief"],
         "nodes": kinds,
         "counts": {k: v for k, v in info.items() if k != "keys"} | {"kept": len(info["keys"])},
         "examples": [{"key": g.key, "bits": round(g.bits, 2), "sentence": g.sentence()} for g in goals[::step]],

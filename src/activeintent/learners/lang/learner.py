@@ -102,6 +102,7 @@ class LangLearner(BayesLearner):
         self.added = LangSpace([])  # goals that joined during this episode
         self.judge = LangJudge(self.base)
         self.keys = {h.name for h in hyps}
+        self.cut = max(h.bits for h in hyps) + 1e-9  # the starting space holds every distinct goal up to here
         self.growth = {"neighbours": 0, "model_answers": 0, "model_fit": 0, "model_new": 0}
         self.model_goals: set[str] = set()
 
@@ -116,7 +117,9 @@ class LangLearner(BayesLearner):
     def _admit(self, goals) -> list[str]:
         """Add goals not held yet (up to the episode's cap), scored on every answer so far."""
         room = self.config.max_added - len(self.added.goals)
-        fresh = [g for g in goals if g.key not in self.keys][:max(room, 0)]
+        # A goal as short as the starting space's longest is in it or behaves like one of it
+        # (de-duplication kept the shortest): adding it would count that behaviour twice.
+        fresh = [g for g in goals if g.key not in self.keys and g.bits > self.cut][:max(room, 0)]
         if not fresh:
             return []
         n_old = len(self.added.goals)
