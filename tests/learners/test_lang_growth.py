@@ -78,6 +78,7 @@ def test_a_conjunction_left_out_of_the_space_joins_it_scored_on_every_answer():
     names = [h.name for h in learner.hyps]
     assert true.key in names
     assert learner.stats()["neighbours"] > 0
+    assert all(h.bits > learner.cut for h in learner.hyps[len(start):])  # shorter ones are in the space already
     b = learner.belief
     log_lik = b.log_w + np.array([h.bits for h in b.hyps]) * np.log(2) + b.log_norm + b.log_evidence
     i, top = names.index(true.key), int(np.argmax(learner.weights))
