@@ -155,3 +155,22 @@ def test_the_embedded_model_proposes_goals_that_parse_under_the_grammar():
     assert 1 <= answered <= 2
     for g in goals:
         assert parse_goal(g.key) == g and 1 <= len(g.clauses) <= MAX_CLAUSES
+
+
+def test_an_episode_does_not_depend_on_the_episodes_run_before_it_in_the_process():
+    """The space is shared by the episodes of a process (built once); the planner's verdicts
+    of one episode must not leak into the next: same seeds, same episode, whatever ran before
+    (this case differed when they leaked)."""
+    from activeintent.protocol import trial_seeds
+    from activeintent.runner import RunOptions, build_episode
+
+    def run(intention: str):
+        seed, test_seed = trial_seeds(0, intention, 0)
+        opts = RunOptions(method="lang-stop", intention=intention, env="symbolic", llm="none", budget=5,
+                          video="none", seed=seed, test_seed=test_seed, prior="uniform")
+        r = build_episode(opts).run()
+        return r.success_at, r.final_z, r.answers
+
+    first = run("align")
+    run("stack")
+    assert run("align") == first

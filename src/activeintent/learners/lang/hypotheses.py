@@ -48,29 +48,35 @@ class LangSpace:
             got = self._feasible[objects] = (len(failed), arr)
         return got[1]
 
+    def reset(self) -> None:
+        """Forget the planner's verdicts (a new episode starts from the static checks only:
+        what an earlier episode in the same process planned must not change this one)."""
+        self.failed.clear()
+        self._feasible.clear()
+
     def plans(self, i: int, state: WorldState, variants: int | None = None) -> list[list[Skill]]:
         n = variants or self.variants
         key = (i, n, tuple(sorted(state.positions.items())))
-        got = self._plans.get(key)
-        if got is not None:
-            return got
-        goal = self.goals[i]
-        out: list[list[Skill]] = []
-        seen: set[str] = set()
-        for v in range(n):
-            p = planner.plan(goal, state, variant=v)
-            if p is None:
-                if v == 0:
-                    self.failed.setdefault(tuple(state.scene.objects), set()).add(i)
-                    break
-                continue
-            k = repr(p)
-            if k not in seen:
-                seen.add(k)
-                out.append(p)
-        self._plans[key] = out
-        if len(self._plans) > 20000:
-            self._plans.popitem(last=False)
+        out = self._plans.get(key)  # plans are a pure function of (goal, state): shared by episodes
+        if out is None:
+            goal = self.goals[i]
+            out = []
+            seen: set[str] = set()
+            for v in range(n):
+                p = planner.plan(goal, state, variant=v)
+                if p is None:
+                    if v == 0:
+                        break
+                    continue
+                k = repr(p)
+                if k not in seen:
+                    seen.add(k)
+                    out.append(p)
+            self._plans[key] = out
+            if len(self._plans) > 20000:
+                self._plans.popitem(last=False)
+        if not out:  # the planner found no plan: infeasible in this scene from now on (this episode)
+            self.failed.setdefault(tuple(state.scene.objects), set()).add(i)
         return out
 
 

@@ -98,6 +98,8 @@ class LangLearner(BayesLearner):
         spaces = list(dict.fromkeys(h.space for h in hyps))
         if tuple(h for sp in spaces for h in sp.hypotheses) != hyps:
             raise ValueError("lang learner: hypotheses must be whole LangSpaces, in order")
+        for sp in spaces:
+            sp.reset()  # the shared space keeps no planner verdicts from an earlier episode
         self.base = spaces
         self.added = LangSpace([])  # goals that joined during this episode
         self.judge = LangJudge(self.base)
