@@ -150,8 +150,10 @@ class LangLearner(BayesLearner):
             for i, o in enumerate(self.observations, 1))
         likely = [(h.goal, w) for h, w in self.top(5)]  # type: ignore[attr-defined]
         try:
+            # the request's seed is not drawn from the learner's generator: asking the model must
+            # not change which queries follow, so runs with and without --llm stay paired
             goals, answered = propose_goals(self.llm, likely, history, self.config.proposals_per_call,  # type: ignore[arg-type]
-                                            seed=int(self.rng.integers(2**31)))
+                                            seed=len(self.observations))
         except ModelError as err:
             self.proposal_errors.append(str(err)[:300])
             return []
