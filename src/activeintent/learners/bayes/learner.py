@@ -186,6 +186,14 @@ class BayesLearner(Learner):
         lik = self.sig.likelihood(obs.answer, obs.shown, judge_, self.model)
         return lik * np.where(feasible, 1 - e, e)
 
+    def _log_lik(self, judge: HypothesisJudge) -> np.ndarray:
+        """Σ_k log P(h_k | z) over every answer so far, for the hypotheses ``judge`` judges
+        (hypotheses that join the belief later are scored on the whole history)."""
+        total = np.zeros(judge.size)
+        for obs in self.observations:
+            total += np.log(np.clip(self._likelihood(obs, judge.hyps, judge), 1e-300, None))
+        return total
+
     def observe(self, record: RoundRecord, trajectories: list[Trajectory]) -> str | None:
         answer = record.answer
         if answer is None:
@@ -240,11 +248,7 @@ class BayesLearner(Learner):
         new = [h for h in new if h.name not in names]
         if not new:
             return []
-        sub = tuple(new)
-        sub_judge = HypothesisJudge(sub)
-        log_lik = np.zeros(len(sub))
-        for obs in self.observations:
-            log_lik += np.log(np.clip(self._likelihood(obs, sub, sub_judge), 1e-300, None))
+        log_lik = self._log_lik(HypothesisJudge(tuple(new)))
         self.belief.add(new, self.config.proposal_mass, log_lik)
         self.judge = HypothesisJudge(self.belief.hyps)
         return [h.description for h in new]

@@ -110,12 +110,6 @@ class LangLearner(BayesLearner):
 
     # ---- growing the space ----
 
-    def _log_lik(self, judge: HypothesisJudge) -> np.ndarray:
-        total = np.zeros(judge.size)
-        for obs in self.observations:
-            total += np.log(np.clip(self._likelihood(obs, judge.hyps, judge), 1e-300, None))
-        return total
-
     def _admit(self, goals) -> list[str]:
         """Add goals not held yet (up to the episode's cap), scored on every answer so far."""
         room = self.config.max_added - len(self.added.goals)
