@@ -170,10 +170,11 @@ class LangLearner(BayesLearner):
         out = super().stats()
         w = self.weights
         model = np.array([h.name in self.model_goals for h in self.hyps])
+        start = sum(len(sp.goals) for sp in self.base)
         out.update(self.growth)
         out.update({
-            "space_start": sum(len(sp.goals) for sp in self.base),
-            "added_mass": round(float(w[sum(len(sp.goals) for sp in self.base):].sum()), 4),
+            "space_start": start,
+            "added_mass": round(float(w[start:].sum()), 4),
             "model_goal_mass": round(float(w[model].sum()), 4) if model.any() else 0.0,
             "top_is_model_goal": bool(self.top()[0][0].name in self.model_goals),
         })

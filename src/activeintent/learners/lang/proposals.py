@@ -43,16 +43,24 @@ def _swap_params(c):
     return out
 
 
+def canonical(clauses, stays: bool) -> Goal | None:
+    """The goal of ``clauses`` with its clauses in one order (by key), so one conjunction has one
+    key; None when a clause repeats or there are more than ``MAX_CLAUSES``."""
+    keys = [c.key for c in clauses]
+    if not 1 <= len(keys) <= MAX_CLAUSES or len(set(keys)) != len(keys):
+        return None
+    return Goal(tuple(sorted(clauses, key=lambda c: c.key)), stays)
+
+
 def neighbours(goals: list[Goal], partners: list[Goal] | None = None) -> list[Goal]:
     """Goals one move away from ``goals`` (the likely ones), and each of them joined with
     each of ``partners`` (more likely goals: a clause not yet tested may be the missing one)."""
     out: dict[str, Goal] = {}
 
     def add(g: Goal) -> None:
-        keys = [c.key for c in g.clauses]
-        if 1 <= len(keys) <= MAX_CLAUSES and len(set(keys)) == len(keys):
-            g = Goal(tuple(sorted(g.clauses, key=lambda c: c.key)), g.stays)
-            out.setdefault(g.key, g)
+        got = canonical(g.clauses, g.stays)
+        if got is not None:
+            out.setdefault(got.key, got)
 
     for g in goals:
         add(Goal(g.clauses, not g.stays))
@@ -114,10 +122,7 @@ def to_goal(proposal) -> Goal | None:
                 return None
             rel, rp = c.predicate.split(":", 1)
             clauses.append(Each(c.quantifier, sel, sp, rel, rp))
-    keys = [c.key for c in clauses]
-    if len(set(keys)) != len(keys):
-        return None
-    return Goal(tuple(sorted(clauses, key=lambda c: c.key)), proposal.others_stay)
+    return canonical(clauses, proposal.others_stay)
 
 
 def propose_goals(llm: ChatModel, likely: list[tuple[Goal, float]], history: str, count: int = 3,
