@@ -1,4 +1,5 @@
-"""Test helpers: a kinematic trajectory (no physics) built from the symbolic world model."""
+"""Test helpers: a kinematic trajectory (no physics) built from the symbolic world model, and
+hand-built world states for judging intentions."""
 
 from __future__ import annotations
 
@@ -43,3 +44,18 @@ def kinematic_trajectory(scene: Scene, seed: int, plan: list[Skill], dt: float =
                       joint_positions=np.zeros((t, 9)), ee_pose=np.zeros((t, 7)),
                       gripper_closed=np.zeros(t, dtype=bool), step_index=np.array(step_index),
                       steps=steps, initial_state=WorldState(positions=layout(scene, seed)), final_state=state)
+
+
+# ---- hand-built states ----------------------------------------------------------------------
+
+T = 0.02  # block centre resting on the table
+IN = 0.026  # block centre resting on a bowl's floor
+UP = 0.04  # one block higher
+
+
+def S(**objects):
+    """WorldState from keyword names: red_block=(x, y, z)."""
+    return WorldState(positions={k.replace("_", " "): tuple(map(float, v)) for k, v in objects.items()})
+
+
+BOWLS = dict(red_bowl=(-0.2, -0.3, 0), blue_bowl=(0.2, -0.3, 0))

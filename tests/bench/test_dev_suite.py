@@ -25,23 +25,13 @@ from activeintent.world import (
     apply_skill,
     layout,
 )
+from helpers import BOWLS, IN, UP, S, T
 
 ROOT = Path(__file__).resolve().parents[2]
 DEV = dev_intentions()
 BY_NAME = {it.name: it for it in DEV}
 SEEDS = range(20)
 
-T = 0.02  # block centre resting on the table
-IN = 0.026  # block centre resting on a bowl's floor
-UP = 0.04  # one block higher
-
-
-def S(**objects):
-    """WorldState from keyword names: red_block=(x, y, z)."""
-    return WorldState(positions={k.replace("_", " "): tuple(map(float, v)) for k, v in objects.items()})
-
-
-BOWLS = dict(red_bowl=(-0.2, -0.3, 0), blue_bowl=(0.2, -0.3, 0))
 
 
 def test_ten_unique_kebab_case_names_with_one_sentence_each():

@@ -16,18 +16,7 @@ from activeintent.world import (
     apply_skill,
     layout,
 )
-
-T = 0.02  # block centre resting on the table
-IN = 0.026  # block centre resting on a bowl's floor
-UP = 0.04  # one block higher
-
-
-def S(**objects):
-    """WorldState from keyword names: red_block=(x, y, z)."""
-    return WorldState(positions={k.replace("_", " "): tuple(map(float, v)) for k, v in objects.items()})
-
-
-BOWLS = dict(red_bowl=(-0.2, -0.3, 0), blue_bowl=(0.2, -0.3, 0))
+from helpers import BOWLS, IN, UP, S, T
 
 # (intention, states that satisfy it, states that break it)
 CASES = {
