@@ -12,7 +12,7 @@ from activeintent.envs.symbolic import SymbolicEnv
 from activeintent.episode import Episode, EpisodeConfig
 from activeintent.learners.registry import LearnerContext, get_method
 from activeintent.llm.scripted import ScriptedModel
-from activeintent.protocol import trial_seeds
+from activeintent.protocol import FORMAT_VERSION, trial_seeds
 from activeintent.records import read_rounds
 from activeintent.runner import RunOptions, build_episode
 from activeintent.signals import get_signal
@@ -95,7 +95,8 @@ def test_infeasible_test_scenes_are_excluded_from_scoring_only():
     r = build_episode(RunOptions(method="bayes-stop", intention="color-match", env="symbolic", llm="none",
                                  video="none", budget=1, seed=5)).run()
     feasible = [t for t in r.tests if t.feasible]
-    assert 0 < r.test_excluded < r.test_scenes == len(r.tests)
+    assert 0 < r.test_excluded < r.test_scenes + r.test_pool == len(r.tests)
+    assert r.test_scored == len(feasible) == len(r.tests) - r.test_excluded
     assert r.success == pytest.approx(sum(t.success for t in feasible) / len(feasible))
 
 
@@ -116,7 +117,7 @@ def test_round_records_explain_the_query(tmp_path):
                              video="none", budget=2, seed=1), tmp_path).run()
     rounds = read_rounds(tmp_path / "rounds.jsonl")
     for r in rounds:
-        assert r["format"] == 2 and r["labels"] == ["A", "B"]
+        assert r["format"] == FORMAT_VERSION and r["labels"] == ["A", "B"]
         if not r["answer"]["new_scene"]:
             assert r["why"]["eig_nats"] > 0 and len(r["why"]["alternatives"]) == 3
             assert all(a["eig_nats"] <= r["why"]["eig_nats"] + 1e-3 for a in r["why"]["alternatives"])

@@ -80,6 +80,7 @@ def run(
     budget: opt.Budget = D.budget,
     seed: opt.Seed = D.seed,
     test_scenes: opt.TestScenes = D.test_scenes,
+    test_pool: opt.TestPool = D.test_pool,
     env: opt.Env = D.env,
     user: opt.User = D.user,
     new_scene: opt.NewScene = D.new_scene,
@@ -114,7 +115,7 @@ def run(
     try:
         options = opt.run_options(
             method=method, intention=intention, intention_file=intention_file, plugins=plugin, budget=budget,
-            seed=seed, test_scenes=test_scenes, env=env, user=user, new_scene=new_scene, prior=prior, llm=llm,
+            seed=seed, test_scenes=test_scenes, test_pool=test_pool, env=env, user=user, new_scene=new_scene, prior=prior, llm=llm,
             vlm=vlm, base_url=base_url, cache=cache, cache_mode=cache_mode, executor=executor,
             retriever=retriever, epsilon=epsilon, early_threshold=early_threshold, variant=variant, video=video,
             design_scenes=design_scenes,
@@ -162,7 +163,7 @@ def run(
         raise typer.Exit(3)
     rate = "n/a (no test scene feasible)" if result.success is None else f"{result.success:.2f}"
     console.print(
-        f"success@{result.budget} = {rate} on {result.test_scenes - result.test_excluded} test scenes "
+        f"success@{result.budget} = {rate} on {result.test_scored or 0} test scenes "
         f"({result.test_excluded} excluded: the hidden intention cannot be shown there) · "
         f"{result.method} on {result.intention} · final z = “{result.final_z}” · {result.signals_used} signals "
         f"{dict(result.answers)} · {result.llm_calls} model calls · {result.wall_s:.0f} s · {out_dir}/summary.json"

@@ -34,6 +34,7 @@ from activeintent.learners.base import Estimate, Learner, RoundRecord
 from activeintent.llm.base import ModelError
 from activeintent.protocol import (
     DEFAULT_BUDGET,
+    DEFAULT_TEST_POOL,
     DEFAULT_TEST_SCENES,
     FORMAT_VERSION,
     FREE_NEW_SCENES,
@@ -41,6 +42,7 @@ from activeintent.protocol import (
     sample_round_scene,
     sample_test_scene,
 )
+from activeintent.provenance import provenance
 from activeintent.records import EpisodeRecorder
 from activeintent.signals import Answer
 from activeintent.world import Scene, Skill, WorldState, apply_plan, describe_plan, layout
@@ -51,7 +53,8 @@ class EpisodeConfig(BaseModel):
     budget: int = Field(DEFAULT_BUDGET, ge=0, le=100, description="K: signals the user gives")
     seed: int = Field(0, ge=0, description="seed of the episode's query scenes, user noise and learner")
     test_seed: int | None = Field(None, ge=0, description="seed of the test scenes (default: from seed)")
-    test_scenes: int = Field(DEFAULT_TEST_SCENES, ge=1, le=200)
+    test_scenes: int = Field(DEFAULT_TEST_SCENES, ge=1, le=200, description="test scenes scored after every signal")
+    test_pool: int = Field(DEFAULT_TEST_POOL, ge=0, le=1000, description="more test scenes, scored at k = K only")
     new_scene: NewSceneRule = "counted"
     stop_when_done: bool = Field(False, description="end early when a learner allowed to finish says done (not in benchmarks)")
     curve: bool = Field(True, description="score after every signal (False: only at k = K)")
@@ -130,12 +133,14 @@ class EpisodeResult(BaseModel):
     env: str
     budget: int
     new_scene: str
-    success: float | None  # success@K: share of feasible test scenes satisfied
-    success_at: list[float | None]
+    success: float | None  # success@K: share of the feasible scenes of the whole test pool satisfied
+    success_at: list[float | None]  # k < K: on the first test_scenes scenes; k = K: the whole pool
     success_physics: float | None = None
     physics_disagreements: int | None = None
-    test_scenes: int
-    test_excluded: int  # infeasible for the hidden intention, not scored
+    test_scenes: int  # scored at every k
+    test_pool: int = 0  # scored at k = K besides them
+    test_excluded: int  # of the scenes scored at k = K: infeasible for the hidden intention, not scored
+    test_scored: int | None = None  # of the scenes scored at k = K: feasible, so scored
     signals_used: int
     answers: dict[str, int] = Field(default_factory=dict)
     rounds_used: int
@@ -154,6 +159,7 @@ class EpisodeResult(BaseModel):
     user: dict = Field(default_factory=dict)
     error: str | None = None
     config: dict = Field(default_factory=dict)
+    provenance: dict = Field(default_factory=dict)  # provenance.py: code, versions, CPU, date
 
 
 @dataclass
@@ -247,13 +253,19 @@ class Episode:
 
     # -- scoring -------------------------------------------------------------------------------
     def _test_set(self) -> list[tuple[Scene, int]]:
+        """The curve's scenes first, then the rest of the pool (one draw: the first ``test_scenes``
+        do not depend on the pool's size)."""
         rng = np.random.default_rng(self.seeds.test)
-        return [(sample_test_scene(rng), int(rng.integers(2**31))) for _ in range(self.config.test_scenes)]
+        n = self.config.test_scenes + self.config.test_pool
+        return [(sample_test_scene(rng), int(rng.integers(2**31))) for _ in range(n)]
 
-    def _score(self, k: int, tests: list[tuple[Scene, int]], physics: bool) -> tuple[float | None, list[TestLog]]:
-        """The learner's current answer on every test scene; success over the feasible ones."""
+    def _score(self, k: int, tests: list[tuple[Scene, int]], physics: bool, final: bool
+               ) -> tuple[float | None, list[TestLog]]:
+        """The learner's current answer on the test scenes (``final``: the whole pool, else the
+        curve's); success over the feasible ones. Physics runs on the curve's scenes only."""
         logs = []
-        for i, (scene, seed) in enumerate(tests):
+        for i, (scene, seed) in enumerate(tests if final else tests[:self.config.test_scenes]):
+            physics_here = physics and i < self.config.test_scenes
             state = WorldState(positions=layout(scene, seed))
             est, plans, failures = self._ground(self.learner.final, scene, state)
             plan = plans[0] if plans else []
@@ -263,7 +275,7 @@ class Episode:
             log = TestLog(scene=list(scene.objects), layout_seed=seed, z=est.z, goal=est.goals[0] if est.goals else "",
                           plan=describe_plan(plan), failure=failures[0] if failures else None, feasible=feasible,
                           success=bool(self.clock.timed("scoring_s", self.intention.satisfied, end)))
-            if physics:
+            if physics_here:
                 self.clock.timed("env_s", self.env.reset, scene, seed)
                 traj = self.clock.timed("env_s", self.env.execute, plan)
                 log.success_physics = bool(self.clock.timed("scoring_s", self.intention.satisfied, traj.outcome))
@@ -299,8 +311,7 @@ class Episode:
         physics = self.env.name != "symbolic"
         try:
             if cfg.curve or cfg.budget == 0 or not self.learner.asks:
-                # A learner that never asks is final at k = 0: score it in physics right away.
-                rate, test_logs = self._score(0, tests, physics and (cfg.budget == 0 or not self.learner.asks))
+                rate, test_logs = self._score(0, tests, physics and cfg.budget == 0, final=cfg.budget == 0)
             else:  # slow learners (model calls) are scored at k = K only
                 rate = None
             success_at.append(rate)
@@ -317,18 +328,19 @@ class Episode:
                 if log.done and done_at is None:
                     done_at = signals
                 if log.counted and (cfg.curve or signals == cfg.budget):
-                    rate, test_logs = self._score(signals, tests, physics and signals == cfg.budget)
+                    last = signals == cfg.budget
+                    rate, test_logs = self._score(signals, tests, physics and last, final=last)
                     success_at.append(rate)
                 elif log.counted:
                     success_at.append(None)
                 if log.done and cfg.stop_when_done and self.learner.may_finish:
                     break
-            if not self.learner.asks or signals < cfg.budget:
+            if signals < cfg.budget:
                 # No more signals come (zero-signal baseline, or the learner finished): its answer
-                # stands for the rest of the budget.
-                if physics and self.learner.asks and signals > 0:
-                    rate, test_logs = self._score(signals, tests, True)
-                success_at += [rate] * (cfg.budget + 1 - len(success_at))
+                # stands for the rest of the budget, and is scored on the whole pool for k = K.
+                success_at += [rate] * (cfg.budget - len(success_at))
+                rate, test_logs = self._score(signals, tests, physics, final=True)
+                success_at.append(rate)
         except ModelError as err:
             error = f"model error after {signals} signals: {err}"
             success_at += [None] * (cfg.budget + 1 - len(success_at))
@@ -348,8 +360,10 @@ class Episode:
             success_at=success_at,
             success_physics=float(np.mean([t.success_physics for t in physics_scored])) if physics_scored else None,
             physics_disagreements=sum(t.success != t.success_physics for t in physics_scored) if physics_scored else None,
-            test_scenes=len(tests),
+            test_scenes=cfg.test_scenes,
+            test_pool=cfg.test_pool,
             test_excluded=sum(not t.feasible for t in test_logs),
+            test_scored=sum(t.feasible for t in test_logs) if test_logs else None,
             signals_used=signals,
             answers=dict(Counter(answer_kind_from_dump(log.answer) for log in logs)),
             rounds_used=len(logs),
@@ -368,6 +382,7 @@ class Episode:
             user=getattr(self.user, "parameters", lambda: {})(),
             error=error,
             config={"episode": cfg.model_dump(), **self.extra_config},
+            provenance=provenance(),
         )
         self.emit("finished", result)
         return result

@@ -19,6 +19,7 @@ Plugin = Annotated[list[str] | None, typer.Option("--plugin", help="Python file 
 Budget = Annotated[int, typer.Option("--budget", min=0, max=100, help="K: signals the user gives; every answer counts")]
 Seed = Annotated[int, typer.Option("--seed", min=0, help="Seed of every random choice")]
 TestScenes = Annotated[int, typer.Option("--test-scenes", min=1, max=200, help="Test scenes scored after every signal")]
+TestPool = Annotated[int, typer.Option("--test-pool", min=0, max=1000, help="More test scenes, scored after the last signal (k = K)")]
 Env = Annotated[str, typer.Option("--env", help="Where plans run: pybullet | symbolic")]
 User = Annotated[str, typer.Option("--user", help="Simulated-user preset: human | paper | exact (see docs/protocol.md)")]
 NewScene = Annotated[str, typer.Option("--new-scene", help="counted (every answer is a signal) | free (old rule, ≤3 uncounted) | off")]

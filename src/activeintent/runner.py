@@ -13,7 +13,12 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field
 
 from activeintent.episode import Episode, EpisodeConfig, EpisodeSeeds
-from activeintent.protocol import DEFAULT_BUDGET, DEFAULT_TEST_SCENES, NewSceneRule
+from activeintent.protocol import (
+    DEFAULT_BUDGET,
+    DEFAULT_TEST_POOL,
+    DEFAULT_TEST_SCENES,
+    NewSceneRule,
+)
 
 DEFAULT_METHOD = "bayes-stop"
 DEFAULT_INTENTION = "color-match"
@@ -32,6 +37,7 @@ class RunOptions(BaseModel):
     seed: int = Field(0, ge=0)
     test_seed: int | None = Field(None, ge=0)
     test_scenes: int = Field(DEFAULT_TEST_SCENES, ge=1, le=200)
+    test_pool: int = Field(DEFAULT_TEST_POOL, ge=0, le=1000)
     env: str = "pybullet"
     user: str = "human"
     new_scene: NewSceneRule = "counted"
@@ -138,7 +144,7 @@ def build_episode(
         if options.new_scene == "off":
             user.profile = user.profile.model_copy(update={"new_scene_false": 0.0, "new_scene_miss": 1.0})
     config = EpisodeConfig(budget=options.budget, seed=options.seed, test_seed=options.test_seed,
-                           test_scenes=options.test_scenes, new_scene=options.new_scene, curve=options.curve,
+                           test_scenes=options.test_scenes, test_pool=options.test_pool, new_scene=options.new_scene, curve=options.curve,
                            video=options.video, stop_when_done=options.stop_when_done)
     observers = list(observers or [])
     return Episode(learner, intention, user, executor, env or make_env(options.env), config, observers,

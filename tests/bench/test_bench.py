@@ -46,7 +46,7 @@ def test_tiny_bench_records_the_protocol_and_reports_intervals_and_baselines(tmp
     records = run_bench(tiny(), tmp_path / "one")
     assert len(records) == 4 and not any(r.get("error") for r in records)
     for r in records:
-        assert r["format"] == 2 and all(k in r for k in PROTOCOL)
+        assert r["format"] == FORMAT_VERSION and all(k in r for k in PROTOCOL)
         assert len(r["success_at"]) == 3 and r["test_scenes"] >= 10
         assert r["signals_used"] == (2 if r["method"] == "bayes-stop" else 0)
         assert r["user_preset"] == "human" and r["new_scene"] == "counted"

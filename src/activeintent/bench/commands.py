@@ -49,6 +49,7 @@ def bench(
     budget: opt.Budget = D.budget,
     seed: opt.Seed = D.seed,
     test_scenes: opt.TestScenes = D.test_scenes,
+    test_pool: opt.TestPool = D.test_pool,
     env: opt.Env = D.env,
     user: opt.User = D.user,
     new_scene: opt.NewScene = D.new_scene,
@@ -97,7 +98,7 @@ def bench(
             methods, suite, preset_trials = _apply_preset(preset, methods, intentions, budget)
             trials = trials or preset_trials
         trials = trials or 20
-        run = opt.run_options(plugins=plugin, budget=budget, test_scenes=test_scenes, env=env, user=user,
+        run = opt.run_options(plugins=plugin, budget=budget, test_scenes=test_scenes, test_pool=test_pool, env=env, user=user,
                               new_scene=new_scene, prior=prior, llm=llm, vlm=vlm, base_url=base_url, cache=cache,
                               cache_mode=cache_mode, executor=executor, retriever=retriever, variant=variant,
                               epsilon=epsilon, early_threshold=early_threshold, curve=curve, video="none")

@@ -47,6 +47,31 @@ def wilson(successes: float, n: int, z: float = 1.96) -> tuple[float, float]:
     return (max(0.0, centre - half), min(1.0, centre + half))
 
 
+# EIG learners and the baselines that share their belief but ask at random.
+PAIRED = (("bayes-stop", "random-query"), ("bayes-preference", "random-query-preference"))
+
+
+def auc(curve: list[float | None]) -> float | None:
+    """Area under success@k over k = 0..K, as the mean of the curve (None if a point is missing)."""
+    return None if not curve or any(v is None for v in curve) else float(np.mean(curve))
+
+
+def paired_difference(records: list[dict], a: str, b: str) -> dict | None:
+    """Method ``a`` minus ``b`` in AUC on the same episodes (same intention and trial: same query-
+    scene seeds, user noise and test scenes): mean, 95 % interval (normal approximation of the
+    paired mean, n = pairs), wins, ties, losses."""
+    per = {m: {(r["intention"], r["trial"]): auc(r.get("success_at") or []) for r in records
+               if r["method"] == m and _ok(r)} for m in (a, b)}
+    diffs = np.array([per[a][k] - per[b][k] for k in sorted(set(per[a]) & set(per[b]))
+                      if per[a][k] is not None and per[b][k] is not None])
+    if len(diffs) < 2:
+        return None
+    half = 1.96 * float(diffs.std(ddof=1)) / math.sqrt(len(diffs))
+    mean = float(diffs.mean())
+    return {"a": a, "b": b, "n": len(diffs), "mean": mean, "lo": mean - half, "hi": mean + half,
+            "wins": int((diffs > 1e-9).sum()), "ties": int((abs(diffs) <= 1e-9).sum()), "losses": int((diffs < -1e-9).sum())}
+
+
 def rate(values: list[float]) -> str:
     if not values:
         return "–"
@@ -62,6 +87,28 @@ def _short(intention: str) -> str:
     return intention.rsplit(":", 1)[-1] if ".py:" in intention else intention
 
 
+MIN_SCORED = 5  # an episode scored on fewer test scenes than this is named in the report
+
+
+def _scored_line(by: dict, methods: list[str], names: list[str]) -> str:
+    """How many test scenes the suite's episodes were scored on at k = K, and which intentions
+    had an episode scored on fewer than MIN_SCORED."""
+    counts = {i: [r["test_scored"] for m in methods for r in by.get((m, i), [])
+                  if not r.get("error") and r.get("test_scored") is not None] for i in names}
+    every = [c for v in counts.values() for c in v]
+    if not every:
+        return "Scored test scenes at k = K: not recorded (records older than format 3)."
+    few = {i: min(v) for i, v in counts.items() if v and min(v) < MIN_SCORED}
+    line = (f"Scored test scenes at k = K per episode: minimum **{min(every)}**, median {int(np.median(every))} "
+            f"({len(every)} episodes).")
+    if few:
+        line += (f" Scored on fewer than {MIN_SCORED} in some episode (the intention can be shown in few scenes of "
+                 "the intention-independent test distribution): " + ", ".join(f"{_short(i)} (min {c})" for i, c in few.items()) + ".")
+    else:
+        line += f" Every episode was scored on at least {MIN_SCORED}."
+    return line
+
+
 def write_report(records: list[dict], methods: list[str], intentions: list[str], out: Path, settings: dict) -> Path:
     by = defaultdict(list)
     for r in records:
@@ -74,8 +121,15 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
         "episode's success is the share of its test scenes (those where the hidden intention can be "
         "satisfied) that end satisfied. Cells: mean over episodes [95 % Wilson interval] (n = episodes). "
         "Test scenes are drawn independently of the hidden intention and are the same for every method "
-        "and intention of a trial.")
+        f"and intention of a trial: {settings.get('test_scenes')} scored after every signal (the curve), "
+        f"{settings.get('test_pool', 0)} more at k = K (success@K is over all of them).")
     lines += ["", "Protocol: " + ", ".join(f"{k} = `{v}`" for k, v in settings.items()), ""]
+    made = sorted({(p.get("commit") or "unknown")[:10] + (" (uncommitted changes)" if p.get("dirty") else "")
+                   for r in records if (p := r.get("provenance"))})
+    cpus = sorted({p.get("cpu") for r in records if (p := r.get("provenance")) and p.get("cpu")})
+    if made:
+        lines += [f"Made by commit {', '.join(made)} on {'; '.join(cpus)} (provenance of every episode: "
+                  "`provenance` in results.jsonl).", ""]
     if settings.get("env") == "symbolic":
         lines += ["**Env: symbolic** — outcomes from the symbolic world model, not physics.", ""]
     suites: dict[str, list[str]] = defaultdict(list)
@@ -101,6 +155,7 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
                 label += " [" + "/".join(sorted({str(r.get("variant") or "structured") for r in ok})) + "]"
             lines.append(f"| {label} | " + " | ".join(cells) + f" | **{rate([r['success'] for r in ok])}** | "
                          f"{signals:.1f} | {new}/{total} | {excl:.1f} | {dis} | {errors} | {len(every) - len(ok) - errors} |")
+        lines += ["", _scored_line(by, methods, names)]
         if suite == "paper":
             cols = [i for i in names if i in PAPER_TABLE1["preference"][0]]
             lines += ["", "The paper's Table 1 (people judged success, 5 trials, 5 signals) with our rows of the "
@@ -126,6 +181,14 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
             vals = [c[k] for c in curves if k < len(c) and c[k] is not None]
             cells.append(f"{np.mean(vals):.2f}" if vals else "–")
         lines.append(f"| {m} | " + " | ".join(cells) + " |")
+    pairs = [d for a, b in PAIRED if a in methods and b in methods and (d := paired_difference(records, a, b))]
+    if pairs:
+        lines += ["", "## EIG against random questions (paired)", "",
+                  "Area under success@k (mean over k = 0..K) of each episode, minus that of the random-question "
+                  "baseline on the same intention and trial; mean [95 % interval], n = pairs.", "",
+                  "| method − baseline | difference in area | wins / ties / losses |", "|---|---|---|"]
+        lines += [f"| {d['a']} − {d['b']} | {d['mean']:+.3f} [{d['lo']:+.3f}, {d['hi']:+.3f}] (n={d['n']}) | "
+                  f"{d['wins']} / {d['ties']} / {d['losses']} |" for d in pairs]
     lines += ["", "![success vs signals](success_vs_signals.png)", ""]
     path = out / "report.md"
     path.write_text("\n".join(lines))

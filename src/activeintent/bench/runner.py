@@ -61,7 +61,7 @@ class BenchOptions(BaseModel):
 def protocol_fields(run: RunOptions) -> dict:
     """What every results line records about how it was measured."""
     return {"env": run.env, "user_preset": run.user, "budget": run.budget, "new_scene": run.new_scene,
-            "prior": run.prior, "test_scenes": run.test_scenes, "llm": run.llm, "executor": run.executor,
+            "prior": run.prior, "test_scenes": run.test_scenes, "test_pool": run.test_pool, "llm": run.llm, "executor": run.executor,
             "vlm": run.vlm, "retriever": run.retriever, "variant": run.variant}
 
 
@@ -124,8 +124,8 @@ _SETTINGS = ("seed", "run")  # methods, intentions and trials may grow on resume
 
 def _legacy_run(run: dict) -> dict:
     """Values of options that did not exist when an older folder was made: the paper's methods
-    ran what is now ``--variant structured``, and ε was also eq. 3's threshold."""
-    return {"variant": "structured", "early_threshold": run.get("epsilon", 2.0)}
+    ran what is now ``--variant structured``, ε was also eq. 3's threshold, and no test pool was scored at k = K."""
+    return {"variant": "structured", "early_threshold": run.get("epsilon", 2.0), "test_pool": 0}
 
 
 def _check_same_settings(options: BenchOptions, path: Path) -> None:

@@ -1,6 +1,12 @@
 """`activeintent bench-verify DIR`: re-run a sample of a results folder's episodes from its
 recorded settings (``bench.json``) and compare them with the recorded lines, so published
-numbers cannot drift from the code silently."""
+numbers cannot drift from the code silently.
+
+Whole records are compared, except what describes the run rather than the episode: wall time
+and its split, provenance (commit, versions, CPU, date) and tracebacks. A folder written under
+an older record format is refused (it was made by other code: regenerate it), not reported as
+different.
+"""
 
 from __future__ import annotations
 
@@ -10,50 +16,96 @@ from typing import Annotated
 
 import typer
 
-# What must come out the same (timings, token counts and tracebacks may differ).
-COMPARED = ("success", "success_at", "signals_used", "answers", "test_excluded", "final_z", "final_goal")
+from activeintent.protocol import FORMAT_VERSION
+
+NOT_COMPARED = frozenset({"wall_s", "time_split", "provenance", "traceback"})
+
+
+class StaleFolder(ValueError):
+    """The folder was written by code of another record format."""
 
 
 def register(app: typer.Typer) -> None:
     app.command(name="bench-verify")(bench_verify)
 
 
+def differences(recorded: dict, again: dict, prefix: str = "") -> dict[str, tuple]:
+    """Fields whose values differ, nested keys joined by '.' (``NOT_COMPARED`` left out)."""
+    out: dict[str, tuple] = {}
+    for key in sorted(set(recorded) | set(again)):
+        if not prefix and key in NOT_COMPARED:
+            continue
+        a, b = recorded.get(key), again.get(key)
+        if isinstance(a, dict) and isinstance(b, dict):
+            out.update(differences(a, b, f"{prefix}{key}."))
+        elif a != b:
+            out[f"{prefix}{key}"] = (a, b)
+    return out
+
+
+def sample_records(records: list[dict], sample: int) -> list[dict]:
+    """A deterministic spread: round-robin over methods (so every method is re-run once before
+    any twice), each method's records taken from the lowest trials across intentions."""
+    by_method: dict[str, list[dict]] = {}
+    for r in sorted(records, key=lambda r: (r["trial"], r["intention"], r["method"])):
+        by_method.setdefault(r["method"], []).append(r)
+    out: list[dict] = []
+    rank = 0
+    while len(out) < sample and any(rank < len(v) for v in by_method.values()):
+        out += [v[rank] for v in by_method.values() if rank < len(v)][:sample - len(out)]
+        rank += 1
+    return out
+
+
 def verify(folder: Path, sample: int, methods: list[str] | None = None) -> list[dict]:
     """Differences between recorded and re-run episodes (empty when they agree)."""
-    from activeintent.bench.runner import BenchOptions, run_item
+    from activeintent.bench.runner import BenchOptions, WorkItem, run_item
     from activeintent.records import read_results
 
     options = BenchOptions.model_validate_json((folder / "bench.json").read_text())
     records = [r for r in read_results(folder / "results.jsonl") if not r.get("error")]
+    old = sorted({r.get("format") for r in records if r.get("format") != FORMAT_VERSION}, key=str)
+    if old:
+        raise StaleFolder(f"{folder} holds records of format {', '.join(map(str, old))}; this code writes format "
+                          f"{FORMAT_VERSION} (another protocol): regenerate the folder with the command in its "
+                          "report, it cannot be verified")
     if methods:
         records = [r for r in records if r["method"] in methods]
-    # A deterministic spread: the records of the lowest trials, across methods and intentions.
-    records.sort(key=lambda r: (r["trial"], r["intention"], r["method"]))
     diffs = []
-    for rec in records[:sample]:
-        from activeintent.bench.runner import WorkItem
-
+    for rec in sample_records(records, sample):
         item = WorkItem(method=rec["method"], intention=rec["intention"], trial=rec["trial"])
         again = run_item(item, options.run, options.seed, str(folder), keep=False)
-        changed = {k: (rec.get(k), again.get(k)) for k in COMPARED if rec.get(k) != again.get(k)}
+        changed = differences(rec, again)
         if changed:
             diffs.append({"method": item.method, "intention": item.intention, "trial": item.trial, "changed": changed})
     return diffs
 
 
+def _short(value) -> str:
+    text = json.dumps(value, default=str)
+    return text if len(text) <= 90 else text[:87] + "..."
+
+
 def bench_verify(
     folder: Annotated[Path, typer.Argument(help="A results folder written by `bench`")],
-    sample: Annotated[int, typer.Option(min=1, help="Episodes to re-run")] = 4,
+    sample: Annotated[int, typer.Option(min=1, help="Episodes to re-run (spread over the methods)")] = 4,
     methods: Annotated[str, typer.Option(help="Only these methods (comma-separated)")] = "",
 ) -> None:
     """Re-run a sample of a results folder and compare; exit 1 when the code no longer gives
-    the recorded results."""
+    the recorded results, 2 when the folder cannot be verified."""
     if not (folder / "bench.json").is_file():
         typer.echo(f"error: {folder} has no bench.json (not a results folder written by `bench`)", err=True)
         raise typer.Exit(2)
-    diffs = verify(folder, sample, [m for m in methods.split(",") if m] or None)
+    try:
+        diffs = verify(folder, sample, [m for m in methods.split(",") if m] or None)
+    except StaleFolder as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2) from None
+    for d in diffs:
+        typer.echo(f"{d['method']} · {d['intention']} · trial {d['trial']}:")
+        for key, (recorded, again) in d["changed"].items():
+            typer.echo(f"  {key}\n    recorded: {_short(recorded)}\n    re-run:   {_short(again)}")
     if diffs:
-        typer.echo(json.dumps(diffs, indent=2, default=str))
         typer.echo(f"{len(diffs)} of {sample} re-run episodes differ from {folder}/results.jsonl", err=True)
         raise typer.Exit(1)
     typer.echo(f"{sample} re-run episodes agree with {folder}/results.jsonl")

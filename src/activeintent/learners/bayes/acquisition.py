@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from pydantic import BaseModel
 
+from activeintent import ranking
 from activeintent.learners.bayes.candidates import Outcome
 from activeintent.signals import Judge, Signal
 from activeintent.world import describe_plan
@@ -53,8 +54,7 @@ def particles(weights: np.ndarray, mass: float = 1 - 1e-4, cap: int = 4000) -> n
     them approximates EIG over H (the neglected tail carries < 1 − mass, or is cut at ``cap``)."""
     if len(weights) <= cap:
         return np.arange(len(weights))
-    top = np.argpartition(-weights, cap - 1)[:cap]
-    top = top[np.argsort(-weights[top], kind="stable")]
+    top = ranking.order(weights, ranking.WEIGHT_DECIMALS)[:cap]
     n = int(np.searchsorted(np.cumsum(weights[top]), mass * weights.sum())) + 1
     return np.sort(top[:min(n, cap)])
 
@@ -107,7 +107,7 @@ def select_query(
         # Among (near-)equal gains prefer short plans: they are quicker to watch.
         gains[n] = eig(weights, with_new_scene(probs, feasible, new_scene_error)) - 1e-4 * sum(
             len(outs[i].plan) for i in combo)
-    order = np.argsort(-gains, kind="stable")
+    order = ranking.order(gains)
     best = combos[order[0]]
     alternatives = [
         {"plans": [describe_plan(outs[i].plan) for i in combos[j]],

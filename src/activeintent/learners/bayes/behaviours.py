@@ -397,11 +397,11 @@ class TwoTowers(Behaviour):
         return f"{s} are stacked into two towers"
 
     def holds(self, f, group):
-        towers = _towers(f, group)
+        towers = _towers(f, group, table_only=True)
         return len(towers) == 2 and all(len(t) >= 2 for t in towers) and sum(map(len, towers)) == len(group)
 
     def ok(self, f, group, b):
-        towers = sorted(_towers(f, group), key=len, reverse=True)
+        towers = sorted(_towers(f, group, table_only=True), key=len, reverse=True)
         return any(b in t for t in towers[:2] if len(t) >= 2)
 
     def feasible(self, objects, group):

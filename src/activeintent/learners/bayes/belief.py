@@ -12,6 +12,7 @@ from typing import Literal
 
 import numpy as np
 
+from activeintent import ranking
 from activeintent.learners.bayes.hypotheses import Hypothesis
 
 Prior = Literal["length", "uniform"]
@@ -52,7 +53,7 @@ class Belief:
 
     def top(self, n: int = 1) -> list[tuple[Hypothesis, float]]:
         w = self.weights
-        return [(self.hyps[i], float(w[i])) for i in np.argsort(-w, kind="stable")[:n]]
+        return [(self.hyps[i], float(w[i])) for i in ranking.order(w, ranking.WEIGHT_DECIMALS)[:n]]
 
     def update(self, likelihood: np.ndarray) -> float:
         """Bayes' rule w_z ← w_z P(h | z) / P(h); returns P(h) = Σ_z w_z P(h | z)."""

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from activeintent import ranking
 from activeintent.envs.symbolic import symbolic_trajectory
 from activeintent.learners.bayes.facts import facts, state_key
 from activeintent.learners.bayes.hypotheses import Hypothesis
@@ -50,7 +51,7 @@ def candidate_plans(
     if feasible is None:
         scene = state.scene
         feasible = np.fromiter((h.feasible(scene) for h in hyps), bool, len(hyps))
-    order = np.argsort(-weights, kind="stable")
+    order = ranking.order(weights, ranking.WEIGHT_DECIMALS)
     feasible = order[feasible[order]].tolist()
     chosen = feasible[:top_k]
     rest = feasible[top_k:]

@@ -67,7 +67,9 @@ def is_cool(block: str) -> bool:
 
 
 def _key(state: WorldState) -> tuple:
-    return tuple((n, round(p[0], 4), round(p[1], 4), round(p[2], 4)) for n, p in state.positions.items())
+    # Exact positions: a key rounded to 0.1 mm handed a state the Facts (xy, pos) of an earlier,
+    # slightly different one, so an episode depended on what the process had computed before.
+    return tuple((n, float(p[0]), float(p[1]), float(p[2])) for n, p in state.positions.items())
 
 
 def state_key(f: Facts) -> tuple:
@@ -80,7 +82,7 @@ _CACHE_SIZE = 20000
 
 
 def facts(state: WorldState) -> Facts:
-    """Facts of ``state`` (memoised on rounded positions)."""
+    """Facts of ``state`` (memoised on its exact positions)."""
     key = _key(state)
     hit = _CACHE.get(key)
     if hit is not None:

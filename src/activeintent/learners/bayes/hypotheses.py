@@ -192,7 +192,7 @@ ALL_FAMILIES: list[tuple[str, list[bh.Behaviour]]] = [
     ("in-any-bowl", [bh.InAnyBowl()]),
     ("on-table", [bh.OnTable()]),
     ("next-to-same-bowl", [bh.NextToSameBowl()]),
-    ("tower", [bh.Tower()]),
+    ("tower", [bh.Tower(table_only=True)]),  # a pile in a bowl is no tower
     ("distinct-corners", [bh.DistinctCorners()]),
     ("row", [bh.Row()]),
     ("column", [bh.Column()]),
@@ -207,7 +207,7 @@ ALL_FAMILIES: list[tuple[str, list[bh.Behaviour]]] = [
     ("region", [bh.InRegion(r) for r in REGIONS]),
 ]
 CLASS_FAMILIES = [
-    (name, [bh.Tower(table_only=True)]) if name == "tower" else (name, members)
+    (name, members)
     for name, members in ALL_FAMILIES
     if name in {"in-same-bowl", "in-other-bowl", "in-any-bowl", "on-table", "next-to-same-bowl",
                 "tower", "row", "column", "cluster", "one-bowl", "in-bowl", "region"}

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from pydantic import BaseModel, Field
 
+from activeintent import ranking
 from activeintent.learners.base import Estimate, Learner, RoundRecord
 from activeintent.learners.bayes.acquisition import Query, select_query
 from activeintent.learners.bayes.belief import Belief, Prior
@@ -157,7 +158,7 @@ class BayesLearner(Learner):
         for _ in range(1 if self.config.choose == "random" else self.config.n_scenes):
             scene = random_scene(self.rng)
             q = self._select(WorldState(positions=layout(scene, int(self.rng.integers(2**31)))))
-            if q is not None and (best is None or q.gain > best[1].gain):
+            if q is not None and (best is None or ranking.greater(q.gain, best[1].gain)):
                 best = (scene, q)
         self.designed = best
         return best[0] if best else None
@@ -227,8 +228,8 @@ class BayesLearner(Learner):
         finals = [facts(o.traj.outcome) for o in outs]
         self.judge.prefetch(finals)
         success = np.array([float(w @ self.judge.judge(f)[0]) for f in finals])
-        best = int(np.argmax(success - 1e-6 * np.array([len(o.plan) for o in outs])))
-        top = self.hyps[int(np.argmax(w))]
+        best = ranking.argmax(success - 1e-6 * np.array([len(o.plan) for o in outs]))
+        top = self.hyps[ranking.argmax(w, ranking.WEIGHT_DECIMALS)]
         plan = outs[best].plan
         return Estimate(z=top.description, goals=[describe_plan(plan)], plans=[plan], done=True,
                         why={"expected_success": round(float(success[best]), 4)})

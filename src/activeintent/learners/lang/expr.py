@@ -465,11 +465,12 @@ class Column(Line):
 
 
 def _towers(f: Facts, g: Group) -> list[list[str]]:
-    """Towers made only of group blocks (a lone block is a tower of height 1), bottom to top."""
+    """Towers made only of group blocks, standing on the table (a pile in a bowl is no tower; a
+    lone block on the table is a tower of height 1), bottom to top."""
     gs = set(g)
     out = []
     for b in g:
-        if f.below[b] is None:
+        if f.below[b] is None and b in f.on_table:
             chain = f.tower(b)
             if all(c in gs for c in chain):
                 out.append(chain)

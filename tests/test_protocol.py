@@ -1,0 +1,48 @@
+"""The test pool is large enough: with the default sizes every intention of every suite can be
+shown in at least 5 of the test scenes scored at k = K, in every trial a default bench runs."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from activeintent.episode import EpisodeSeeds
+from activeintent.protocol import (
+    DEFAULT_TEST_POOL,
+    DEFAULT_TEST_SCENES,
+    sample_test_scene,
+    trial_seeds,
+)
+from activeintent.suites import SUITE_NAMES, resolve, suite
+
+MIN_SCORED = 5
+
+
+def pool(trial: int, bench_seed: int = 0) -> list:
+    """The scenes Episode._test_set draws for a trial (same seed path, same draws)."""
+    _, test_seed = trial_seeds(bench_seed, "any intention", trial)
+    rng = np.random.default_rng(EpisodeSeeds.from_seed(0, test_seed).test)
+    scenes = []
+    for _ in range(DEFAULT_TEST_SCENES + DEFAULT_TEST_POOL):
+        scenes.append(sample_test_scene(rng))
+        rng.integers(2**31)  # the layout seed
+    return scenes
+
+
+@pytest.mark.parametrize("name", SUITE_NAMES)
+def test_every_intention_is_scorable_on_enough_scenes_in_every_default_trial(name):
+    intentions = [resolve(n) for n in suite(name)]
+    for trial in range(20):  # bench's default trial count
+        scenes = pool(trial)
+        fewest = min(sum(bool(it.feasible(s)) for s in scenes) for it in intentions)
+        assert fewest >= MIN_SCORED, f"suite {name}, trial {trial}: an intention is feasible in {fewest} scenes"
+
+
+def test_the_pool_is_the_episodes_own(tmp_path):
+    from activeintent.runner import RunOptions, build_episode
+
+    _, test_seed = trial_seeds(0, "any intention", 3)
+    r = build_episode(RunOptions(method="zero-signal", intention="two-towers", env="symbolic", llm="none",
+                                 video="none", budget=1, seed=1, test_seed=test_seed)).run()
+    assert [t.scene for t in r.tests] == [list(s.objects) for s in pool(3)]
+    assert r.test_scored == sum(bool(resolve("two-towers").feasible(s)) for s in pool(3)) >= MIN_SCORED
