@@ -15,7 +15,7 @@ import pytest
 
 from activeintent.bench.report import wilson, write_report
 from activeintent.bench.runner import BenchOptions, run_bench
-from activeintent.protocol import trial_seeds
+from activeintent.protocol import FORMAT_VERSION, trial_seeds
 from activeintent.records import read_results
 from activeintent.runner import RunOptions
 

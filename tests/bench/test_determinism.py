@@ -39,7 +39,7 @@ def test_episodes_are_identical_under_other_blas_kernels_threads_and_an_empty_ca
     assert made.returncode == 0, made.stderr[-2000:]
     lines = [json.loads(x) for x in (folder / "results.jsonl").read_text().splitlines()]
     assert len(lines) == 6 and not any(r.get("error") for r in lines)
-    for i, (kernel, threads) in enumerate([("Haswell", "1"), ("Prescott", "2")]):
+    for kernel, threads in [("Haswell", "1"), ("Prescott", "2")]:
         again = _cli(["bench-verify", str(folder), "--sample", "6"], tmp_path / f"cache-{kernel}",
                      OPENBLAS_CORETYPE=kernel, OPENBLAS_NUM_THREADS=threads)
         assert again.returncode == 0, f"{kernel}, {threads} thread(s):\n{again.stdout[-4000:]}{again.stderr[-2000:]}"
