@@ -19,9 +19,12 @@ from activeintent.intentions.placement import (
     ROW_PITCH,
     TABLE_INNER,
     grid,
+    is_clear,
     is_warm,
     nearest_first,
     on_table,
+    park,
+    standing_towers,
     top_first,
     towers,
     verified,
@@ -38,6 +41,7 @@ from activeintent.world import (
     Scene,
     Skill,
     WorldState,
+    apply_skill,
     relations,
 )
 
@@ -185,19 +189,26 @@ class Stack(Intention):
     name = "stack"
     description = "Stack all the blocks into a single tower."
 
+    # A tower stands on the table: blocks piled in a bowl are in the bowl, not a tower
+    # (placement.standing_towers).
+
     def satisfied(self, state: WorldState) -> bool:
-        ts = towers(state, relations(state))
+        ts = standing_towers(state, relations(state))
         return len(ts) == 1 and len(ts[0]) == len(state.blocks) > 0
 
     def score(self, state: WorldState) -> float:
         n = len(state.blocks)
-        return len(towers(state, relations(state))[0]) / n if n else 0.0
+        return max((len(t) for t in standing_towers(state, relations(state))), default=0) / n if n else 0.0
 
     def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
         if self.score(after) < self.score(before) - 1e-9:
             return True
-        # Building a tower only ever puts blocks on blocks; anything else is a wasted move.
-        return step.block in after.blocks and relations(after).below(step.block) is None
+        # Building a tower only ever puts blocks on blocks of a tower standing on the table;
+        # anything else (the table, a bowl, a pile in a bowl) is a wasted move.
+        if step.block not in after.blocks:
+            return False
+        rel = relations(after)
+        return rel.below(step.block) is None or not any(step.block in t for t in standing_towers(after, rel))
 
     def feasible(self, scene: Scene) -> bool:
         return len(scene.blocks) >= 2
@@ -211,15 +222,27 @@ class Stack(Intention):
         if self.satisfied(state):
             return []
         rel = relations(state)
-        for keep in towers(state, rel):
-            steps: list[Skill] = []
-            top = keep[-1]
-            for b in top_first(state, [b for b in state.blocks if b not in keep]):
-                steps.append(PutOn(block=b, target=top))
-                top = b
-            if found := verified(self, state, steps):
+        for keep in standing_towers(state, rel):
+            if found := verified(self, state, _stack_onto(state, keep)):
+                return found
+        # No tower stands on the table (every block is in a bowl): set one block down first.
+        for base in top_first(state, [b for b in state.blocks if is_clear(rel, b)]):
+            if (step := park(state, base)) is None:
+                continue
+            after, _ = apply_skill(state, step)
+            if found := verified(self, state, [step, *_stack_onto(after, [base])]):
                 return found
         return None
+
+
+def _stack_onto(state: WorldState, keep: list[str]) -> list[Skill]:
+    """Put every block not in ``keep`` onto its top, topmost blocks first."""
+    steps: list[Skill] = []
+    top = keep[-1]
+    for b in top_first(state, [b for b in state.blocks if b not in keep]):
+        steps.append(PutOn(block=b, target=top))
+        top = b
+    return steps
 
 
 class TwoTowers(Intention):

@@ -1,0 +1,88 @@
+"""Each intention judged against its own one-sentence description on hand-made boundary
+states: what a person reading the sentence would say about the state, the score, a step, and
+whether the scene allows the intention at all (with a property test over many sampled scenes)."""
+
+from __future__ import annotations
+
+import pytest
+
+from activeintent.bench.dev import dev_intentions
+from activeintent.intentions import get_intention
+from activeintent.world import (
+    PutIn,
+    PutOn,
+    WorldState,
+    apply_plan,
+    apply_skill,
+    relations,
+)
+from helpers import BOWLS, IN, UP, S, T
+
+DEV = {it.name: it for it in dev_intentions()}
+
+
+def intention(name: str):
+    return DEV[name] if name in DEV else get_intention(name)
+
+
+def reaches(name: str, state: WorldState) -> bool:
+    """The intention's own plan from ``state`` runs and ends in a state it accepts."""
+    it = intention(name)
+    plan = it.plan(state)
+    if plan is None:
+        return False
+    states, failures = apply_plan(state, plan)
+    return failures == [None] * len(plan) and it.satisfied(states[-1] if states else state)
+
+
+def away(name: str, state: WorldState, step) -> bool:
+    after, failure = apply_skill(state, step)
+    assert failure is None, failure
+    return intention(name).step_moves_away(state, after, step)
+
+
+# --- stack -----------------------------------------------------------------------------------
+
+PILED_IN_BOWL = S(red_block=(-0.2, -0.3, IN), blue_block=(-0.2, -0.3, IN + UP), **BOWLS)
+TOWER_ON_TABLE = S(red_block=(0, -0.5, T), blue_block=(0, -0.5, T + UP), **BOWLS)
+
+
+def test_stack_blocks_piled_in_a_bowl_are_not_a_tower():
+    """"Stack all the blocks into a single tower." Two blocks put one after the other into the
+    same bowl lie on each other (world.relations says `on`, and both are in the bowl), but they
+    are piled in the bowl, not stacked into a tower: "all blocks in one bowl" must not pass."""
+    rel = relations(PILED_IN_BOWL)
+    assert rel.below("blue block") == "red block" and rel.in_bowl("red block") == "red bowl"
+    stack = get_intention("stack")
+    assert not stack.satisfied(PILED_IN_BOWL)
+    assert stack.score(PILED_IN_BOWL) < 1.0
+    assert stack.satisfied(TOWER_ON_TABLE) and stack.score(TOWER_ON_TABLE) == pytest.approx(1.0)
+    # The same pile judged by "all blocks in one bowl" is satisfied: the two must differ.
+    assert get_intention("one-bowl").satisfied(PILED_IN_BOWL)
+    assert reaches("stack", PILED_IN_BOWL)  # the plan sets a block down and stacks on it
+
+
+def test_stack_score_counts_only_a_tower_standing_on_the_table():
+    """"Stack all the blocks into a single tower." Two blocks piled in a bowl and one on the
+    table: the only tower is the lone block on the table (1 of 3)."""
+    state = PILED_IN_BOWL.moved("green block", (0.0, -0.6, T))
+    assert get_intention("stack").score(state) == pytest.approx(1 / 3)
+
+
+def test_stack_putting_a_block_on_a_pile_in_a_bowl_moves_away():
+    """"Stack all the blocks into a single tower." Putting a block onto a block lying in a bowl
+    piles it in the bowl; a person wanting a tower stops that. Onto a block on the table: fine."""
+    state = S(red_block=(-0.2, -0.3, IN), blue_block=(0.0, -0.6, T), green_block=(0.1, -0.7, T), **BOWLS)
+    assert away("stack", state, PutOn(block="blue block", target="red block"))
+    assert not away("stack", state, PutOn(block="blue block", target="green block"))
+    assert away("stack", state, PutIn(block="blue block", bowl="blue bowl"))
+
+
+def test_stack_tower_next_to_a_bowl_and_a_tower_with_a_stray_block():
+    """"Stack all the blocks into a single tower." A tower standing on the table right beside a
+    bowl is a tower; a tower plus one block left on the table is not a single tower of all."""
+    beside = S(red_block=(-0.2 + 0.097, -0.3, T), blue_block=(-0.2 + 0.097, -0.3, T + UP), **BOWLS)
+    assert get_intention("stack").satisfied(beside)
+    stray = TOWER_ON_TABLE.moved("green block", (0.052, -0.5, T))
+    assert not get_intention("stack").satisfied(stray)
+    assert get_intention("stack").score(stray) == pytest.approx(2 / 3)
