@@ -86,3 +86,33 @@ def test_stack_tower_next_to_a_bowl_and_a_tower_with_a_stray_block():
     stray = TOWER_ON_TABLE.moved("green block", (0.052, -0.5, T))
     assert not get_intention("stack").satisfied(stray)
     assert get_intention("stack").score(stray) == pytest.approx(2 / 3)
+
+
+# --- two-towers ------------------------------------------------------------------------------
+
+TWO_PILES_IN_BOWLS = S(red_block=(-0.2, -0.3, IN), blue_block=(-0.2, -0.3, IN + UP),
+                       green_block=(0.2, -0.3, IN), cyan_block=(0.2, -0.3, IN + UP), **BOWLS)
+
+
+def test_two_towers_piles_in_bowls_are_not_towers():
+    """"Stack the blocks into two towers of (nearly) equal height." Two blocks piled in each of
+    two bowls is "two in each bowl", not two towers; one pile in a bowl and a real tower on the
+    table is one tower."""
+    two = get_intention("two-towers")
+    assert not two.satisfied(TWO_PILES_IN_BOWLS)
+    assert two.score(TWO_PILES_IN_BOWLS) == pytest.approx(0.0)
+    one_real = TWO_PILES_IN_BOWLS.moved("green block", (0.0, -0.6, T)).moved("cyan block", (0.0, -0.6, T + UP))
+    assert not two.satisfied(one_real)
+    assert two.score(one_real) == pytest.approx(0.5)
+    real = one_real.moved("red block", (-0.1, -0.7, T)).moved("blue block", (-0.1, -0.7, T + UP))
+    assert two.satisfied(real)
+    assert reaches("two-towers", TWO_PILES_IN_BOWLS) and reaches("two-towers", one_real)
+
+
+def test_two_towers_putting_a_block_on_a_pile_in_a_bowl_moves_away():
+    """"Stack the blocks into two towers of (nearly) equal height." Topping up a pile in a bowl
+    builds no tower."""
+    state = S(red_block=(-0.2, -0.3, IN), blue_block=(0.0, -0.6, T), green_block=(0.1, -0.7, T),
+              cyan_block=(-0.1, -0.7, T), **BOWLS)
+    assert away("two-towers", state, PutOn(block="blue block", target="red block"))
+    assert not away("two-towers", state, PutOn(block="blue block", target="green block"))
