@@ -9,7 +9,9 @@ import pytest
 from activeintent.bench.dev import dev_intentions
 from activeintent.intentions import get_intention
 from activeintent.world import (
+    PutAt,
     PutIn,
+    PutNextTo,
     PutOn,
     WorldState,
     apply_plan,
@@ -116,3 +118,42 @@ def test_two_towers_putting_a_block_on_a_pile_in_a_bowl_moves_away():
               cyan_block=(-0.1, -0.7, T), **BOWLS)
     assert away("two-towers", state, PutOn(block="blue block", target="red block"))
     assert not away("two-towers", state, PutOn(block="blue block", target="green block"))
+
+
+# --- dev-column-along-left-edge ------------------------------------------------------------
+
+def column_at(x: float, n: int = 3, **extra) -> WorldState:
+    names = ["red_block", "blue_block", "green_block", "cyan_block"][:n]
+    return S(**{b: (x, -0.5 - 0.052 * i, T) for i, b in enumerate(names)}, **extra)
+
+
+def test_column_along_the_left_edge_means_near_that_edge():
+    """"Line the blocks up front to back in one straight column along the left edge of the
+    table." A column 6-10 cm from the left edge runs along it; one in the left third but 11 cm
+    from the table's middle line (19 cm from the edge) does not, nor does one in the middle."""
+    column = intention("dev-column-along-left-edge")
+    assert column.satisfied(column_at(-0.26)) and column.satisfied(column_at(-0.2))
+    assert not column.satisfied(column_at(-0.11))
+    assert column.score(column_at(-0.11)) < 1.0
+    assert not column.satisfied(column_at(0.0))
+    assert reaches("dev-column-along-left-edge", column_at(-0.11, **BOWLS))
+
+
+def test_column_along_the_left_edge_with_a_gap_or_a_block_in_a_bowl():
+    """"Line the blocks up front to back in one straight column along the left edge of the
+    table." A column with a gap is two pieces; a block in a bowl by the edge is not in it."""
+    column = intention("dev-column-along-left-edge")
+    gap = column_at(-0.25).moved("green block", (-0.25, -0.75, T))
+    assert not column.satisfied(gap) and column.score(gap) == pytest.approx(2 / 3)
+    bowl = dict(red_bowl=(-0.22, -0.3, 0))
+    in_bowl = column_at(-0.25, n=2, **bowl).moved("green block", (-0.22, -0.3, IN))
+    assert not column.satisfied(in_bowl)
+
+
+def test_column_step_into_the_left_third_but_away_from_the_edge_moves_away():
+    """"Line the blocks up front to back in one straight column along the left edge of the
+    table." Setting a block down 19 cm from the left edge puts it where no such column goes."""
+    state = S(red_block=(-0.25, -0.5, T), blue_block=(0.1, -0.6, T), green_block=(0.2, -0.3, T))
+    assert away("dev-column-along-left-edge", state, PutAt(block="blue block", position=(-0.11, -0.6)))
+    assert not away("dev-column-along-left-edge", state,
+                    PutNextTo(block="blue block", target="red block", side="front"))
