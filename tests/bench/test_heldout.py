@@ -15,6 +15,7 @@ from activeintent.world import (
     PutAt,
     PutIn,
     PutNextTo,
+    Scene,
     WorldState,
     apply_plan,
     apply_skill,
@@ -163,6 +164,24 @@ def test_relations_orderings_and_exceptions_on_hand_built_states():
     assert stay.step_moves_away(start, apply_skill(start, shuffle)[0], shuffle)
     put = PutIn(block="green block", bowl="blue bowl")
     assert not stay.step_moves_away(start, apply_skill(start, put)[0], put)
+
+
+def test_plans_never_crash_on_any_scene():
+    """Every plan returns steps or None, also on scenes where the intention is not feasible
+    (blocks only, bowls only, a single block)."""
+    scenes = [
+        ["red block", "blue block", "green block"],
+        ["red block", "orange block", "blue block", "green block"],
+        ["red bowl", "blue bowl", "green bowl"],
+        ["red block", "red bowl", "blue bowl"],
+        ["blue block", "red bowl", "blue bowl"],
+    ]
+    for objects in scenes:
+        for seed in range(3):
+            state = WorldState(positions=layout(Scene(objects=objects), seed))
+            for intention in heldout_intentions():
+                plan = intention.plan(state)
+                assert plan is None or isinstance(plan, list)
 
 
 @pytest.fixture(scope="module")

@@ -894,6 +894,8 @@ class BowlsExceptRed(_FromBenchmarkScenes, BlockwiseIntention):
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
         if block == self.keep:
             return _park(state, block)
+        if not state.bowls:
+            return None
         counts = _bowl_counts(state, rel)
         # Spread the blocks over the bowls (short piles are steadier), nearest bowl on ties.
         bowl = min(state.bowls, key=lambda w: (counts[w], _distance(state, block, w)))
