@@ -4,20 +4,26 @@ whether the scene allows the intention at all (with a property test over many sa
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from activeintent.bench.dev import dev_intentions
-from activeintent.intentions import get_intention
+from activeintent.intentions import all_intentions, get_intention
+from activeintent.intentions.placement import is_warm
+from activeintent.protocol import sample_test_scene
 from activeintent.world import (
     PutAt,
     PutIn,
     PutNextTo,
     PutOn,
+    Scene,
     WorldState,
     apply_plan,
     apply_skill,
+    layout,
     relations,
 )
+from activeintent.world.skills import TABLE_POSITIONS
 from helpers import BOWLS, IN, UP, S, T
 
 DEV = {it.name: it for it in dev_intentions()}
@@ -157,3 +163,113 @@ def test_column_step_into_the_left_third_but_away_from_the_edge_moves_away():
     assert away("dev-column-along-left-edge", state, PutAt(block="blue block", position=(-0.11, -0.6)))
     assert not away("dev-column-along-left-edge", state,
                     PutNextTo(block="blue block", target="red block", side="front"))
+
+
+# --- feasible(scene) is exactly right -------------------------------------------------------
+#
+# feasible(scene) means "the intention can be shown and satisfied in this scene" (Intention
+# docs): every feasible scene must be satisfiable from any layout, and an infeasible scene must
+# be unsatisfiable, or one where the sentence cannot be shown because the scene lacks what it
+# talks about (listed here, each with the reason).
+
+
+def _warm(scene) -> int:
+    return sum(is_warm(b) for b in scene.blocks)
+
+
+UNSHOWABLE = {
+    # a single block makes no row, tower or group, and is not "together" with anything
+    "align": lambda s: len(s.blocks) < 2,
+    "align-vertical": lambda s: len(s.blocks) < 2,
+    "stack": lambda s: len(s.blocks) < 2,
+    "one-bowl": lambda s: len(s.blocks) < 2,
+    "dev-gather-in-one-corner": lambda s: len(s.blocks) < 2,
+    # two towers of at least two blocks each need four
+    "two-towers": lambda s: len(s.blocks) < 4,
+    # one of the sentence's two colour classes is missing
+    "warm-in-bowls-cool-stacked": lambda s: _warm(s) in (0, len(s.blocks)),
+    "warm-left-cool-right": lambda s: _warm(s) in (0, len(s.blocks)),
+    "dev-warm-on-cool": lambda s: _warm(s) == 0,
+    "dev-warm-and-cool-groups": lambda s: len(s.blocks) < 3 or _warm(s) in (0, len(s.blocks)),
+}
+EVERY = [*all_intentions(), *dev_intentions()]
+ODD_SCENES = [
+    ["red bowl", "blue bowl", "green bowl"],
+    ["red block", "red bowl", "blue bowl"],
+    ["red block", "blue block", "green block"],
+    ["red block", "orange block", "yellow block", "red bowl"],
+    ["blue block", "green block", "cyan block", "gray block", "blue bowl"],
+]
+
+
+def _scenes(it) -> list[Scene]:
+    scenes = [sample_test_scene(np.random.default_rng(100 + i)) for i in range(40)]
+    scenes += [it.sample_scene(np.random.default_rng(200 + i)) for i in range(10)]
+    return scenes + [Scene(objects=o) for o in ODD_SCENES]
+
+
+def _random_states(state: WorldState, rng: np.random.Generator, steps: int) -> list[WorldState]:
+    out = [state]
+    for _ in range(steps):
+        block = str(rng.choice(state.blocks))
+        kind = int(rng.integers(4))
+        if kind == 0 and state.bowls:
+            step = PutIn(block=block, bowl=str(rng.choice(state.bowls)))
+        elif kind == 1:
+            step = PutOn(block=block, target=str(rng.choice(state.blocks)))
+        elif kind == 2:
+            step = PutNextTo(block=block, target=str(rng.choice(state.names)),
+                             side=str(rng.choice(["left", "right", "front", "behind", "nearest"])))
+        else:
+            step = PutAt(block=block, position=str(rng.choice(list(TABLE_POSITIONS))))
+        state, _ = apply_skill(state, step)
+        out.append(state)
+    return out
+
+
+def _goal_states(state: WorldState) -> list[WorldState]:
+    """Where the plans of every library and dev intention lead from ``state``."""
+    out = []
+    for other in EVERY:
+        plan = other.plan(state)
+        if plan is not None:
+            states, failures = apply_plan(state, plan)
+            if not any(failures):
+                out.append(states[-1] if states else state)
+    return out
+
+
+@pytest.mark.parametrize("it", EVERY, ids=lambda i: i.name)
+def test_feasible_scenes_are_satisfiable_and_infeasible_ones_are_not(it):
+    """Each intention's sentence against `feasible`: on test scenes (protocol.sample_test_scene),
+    its own sampled scenes and a few odd ones, a feasible scene is satisfied by the intention's
+    plan from several layouts, and an infeasible one admits no satisfying state among the goal
+    states of all intentions and random moves, unless the scene cannot show the sentence."""
+    unshowable = UNSHOWABLE.get(it.name, lambda s: False)
+    for i, scene in enumerate(_scenes(it)):
+        if it.feasible(scene):
+            assert not unshowable(scene), (it.name, scene)
+            for seed in (i, i + 1000, i + 2000):
+                state = WorldState(positions=layout(scene, seed))
+                assert reaches(it.name, state), (it.name, scene, seed)
+        elif scene.blocks and not unshowable(scene):
+            state = WorldState(positions=layout(scene, i))
+            bank = _goal_states(state) + _random_states(state, np.random.default_rng(i), 20)
+            assert not any(it.satisfied(s) for s in bank), (it.name, scene)
+        else:
+            state = WorldState(positions=layout(scene, i))
+            it.plan(state)  # may be None; must not crash
+            assert 0.0 <= it.score(state) <= 1.0
+
+
+@pytest.mark.parametrize("it", EVERY, ids=lambda i: i.name)
+def test_satisfied_exactly_when_the_score_is_full(it):
+    """A state is satisfied exactly when its score is 1, on random states of feasible scenes."""
+    rng = np.random.default_rng(7)
+    for i, scene in enumerate(_scenes(it)[:25]):
+        if not it.feasible(scene):
+            continue
+        for state in _random_states(WorldState(positions=layout(scene, i)), rng, 12):
+            score = it.score(state)
+            assert 0.0 <= score <= 1.0
+            assert it.satisfied(state) == (score >= 1.0 - 1e-9), (it.name, state, score)
