@@ -273,3 +273,117 @@ def test_satisfied_exactly_when_the_score_is_full(it):
             score = it.score(state)
             assert 0.0 <= score <= 1.0
             assert it.satisfied(state) == (score >= 1.0 - 1e-9), (it.name, state, score)
+
+
+# --- more boundary states, one sentence each --------------------------------------------------
+
+RIM = 0.06  # a block centre between the bowl's inner (5.5 cm) and outer (6.5 cm) radius
+BESIDE = 0.097  # where PutNextTo leaves a block beside a bowl
+
+
+def test_align_row_with_a_gap_and_a_block_by_a_bowl():
+    """"Align all the blocks horizontally: one straight left-to-right row on the table, each
+    block next to its neighbour, none stacked or in a bowl." A row with a 13 cm gap is two
+    pieces (2 of 3); a row whose end block touches a bowl is still a row; a block in a bowl
+    at the row's end is not in it."""
+    align = get_intention("align")
+    gap = S(red_block=(-0.1, -0.5, T), blue_block=(-0.048, -0.5, T), green_block=(0.13, -0.5, T))
+    assert not align.satisfied(gap) and align.score(gap) == pytest.approx(2 / 3)
+    by_bowl = S(red_block=(-0.2 + BESIDE, -0.3, T), blue_block=(-0.2 + BESIDE + 0.052, -0.3, T), **BOWLS)
+    assert align.satisfied(by_bowl)
+    in_bowl = by_bowl.moved("green block", (0.2, -0.3, IN))
+    assert not align.satisfied(in_bowl) and align.score(in_bowl) == pytest.approx(2 / 3)
+    assert away("align", by_bowl.moved("green block", (0.1, -0.6, T)),
+                PutIn(block="green block", bowl="blue bowl"))
+
+
+def test_already_satisfied_starts_need_no_steps_and_breaking_them_moves_away():
+    """"Stack all the blocks into a single tower." / "Put each block in the bowl of the same
+    colour." A start that already realises the sentence needs an empty plan, and taking a
+    block out of it is a move away."""
+    assert get_intention("stack").plan(TOWER_ON_TABLE) == []
+    assert away("stack", TOWER_ON_TABLE, PutAt(block="blue block", position="bottom left corner"))
+    matched = S(red_block=(-0.2, -0.3, IN), blue_block=(0.2, -0.3, IN), **BOWLS)
+    assert get_intention("color-match").plan(matched) == []
+    assert away("color-match", matched, PutAt(block="red block", position="middle"))
+
+
+def test_color_match_wrong_bowl_rim_and_beside():
+    """"Put each block in the bowl of the same colour." A block in the other bowl, beside its
+    bowl, or with its centre over the rim (not inside the inner radius) is not in its bowl; a
+    block lying on another block in its own bowl is."""
+    match = get_intention("color-match")
+    assert not match.satisfied(S(red_block=(0.2, -0.3, IN), blue_block=(-0.2, -0.3, IN), **BOWLS))
+    beside = S(red_block=(-0.2 + BESIDE, -0.3, T), blue_block=(0.2, -0.3, IN), **BOWLS)
+    assert not match.satisfied(beside) and match.score(beside) == pytest.approx(0.5)
+    rim = S(red_block=(-0.2 + RIM, -0.3, T), blue_block=(0.2, -0.3, IN), **BOWLS)
+    assert not match.satisfied(rim)
+    on_other = S(green_block=(-0.2, -0.3, IN), red_block=(-0.2, -0.3, IN + UP), **BOWLS)
+    assert match.wanted(on_other, relations(on_other), "red block")
+
+
+def test_next_to_same_colour_bowl_beside_in_and_stacked():
+    """"Put each block on the table next to (not in) the bowl of its own colour." Beside its
+    own bowl: yes; in it: no; beside the other bowl: no; on top of a block that stands beside
+    its bowl: not on the table."""
+    nxt = get_intention("next-to-same-color-bowl")
+    assert nxt.satisfied(S(red_block=(-0.2 + BESIDE, -0.3, T), **BOWLS))
+    assert not nxt.satisfied(S(red_block=(-0.2, -0.3, IN), **BOWLS))
+    assert not nxt.satisfied(S(red_block=(0.2 - BESIDE, -0.3, T), **BOWLS))
+    stacked = S(red_block=(-0.2 + BESIDE, -0.3, T + UP), green_block=(-0.2 + BESIDE, -0.3, T), **BOWLS)
+    assert not nxt.wanted(stacked, relations(stacked), "red block")
+
+
+def test_one_bowl_and_one_block_per_bowl_on_split_and_shared_bowls():
+    """"Put all the blocks together in one bowl (any bowl)." / "Put each block alone in its own
+    bowl, whatever the colours." One block in each of two bowls satisfies the second and half
+    of the first; both in one bowl the other way round."""
+    split = S(red_block=(-0.2, -0.3, IN), green_block=(0.2, -0.3, IN), **BOWLS)
+    shared = S(red_block=(-0.2, -0.3, IN), green_block=(-0.2, -0.3, IN + UP), **BOWLS)
+    one, alone = get_intention("one-bowl"), get_intention("one-block-per-bowl")
+    assert alone.satisfied(split) and not one.satisfied(split) and one.score(split) == pytest.approx(0.5)
+    assert one.satisfied(shared) and not alone.satisfied(shared) and alone.score(shared) == 0.0
+
+
+def test_warm_in_bowls_cool_stacked_tower_must_stand_on_the_table():
+    """"Put the warm-coloured blocks in bowls and stack the cool-coloured blocks into one tower
+    on the table." Cool blocks piled in a bowl are not a tower on the table; a warm block on
+    top of the cool tower is not in a bowl."""
+    it = get_intention("warm-in-bowls-cool-stacked")
+    piled = S(red_block=(0.2, -0.3, IN), blue_block=(-0.2, -0.3, IN), green_block=(-0.2, -0.3, IN + UP), **BOWLS)
+    assert not it.satisfied(piled)
+    on_top = S(blue_block=(0, -0.6, T), green_block=(0, -0.6, T + UP), red_block=(0, -0.6, T + 2 * UP), **BOWLS)
+    assert not it.satisfied(on_top) and it.score(on_top) == pytest.approx(2 / 3)
+
+
+def test_regions_blocks_in_bowls_and_stacked_blocks():
+    """"Move all the blocks onto the left half of the table (on the table, not in bowls)." /
+    "Put each block on the table in a different corner of the table." A block in a bowl on the
+    left half is not on the table; of two blocks stacked in one corner only the upper one is
+    misplaced (moving it to a free corner completes the sentence)."""
+    left = get_intention("blocks-left-half")
+    assert not left.satisfied(S(red_block=(-0.2, -0.3, IN), blue_block=(-0.1, -0.6, T), **BOWLS))
+    corners = get_intention("blocks-in-corners")
+    stacked = S(red_block=(-0.25, -0.25, T), blue_block=(-0.25, -0.25, T + UP), green_block=(0.25, -0.75, T))
+    assert not corners.satisfied(stacked) and corners.score(stacked) == pytest.approx(2 / 3)
+
+
+def test_empty_scene_satisfies_nothing():
+    """Every sentence is about "the blocks": a table with bowls only is not feasible, satisfies
+    nothing and has no plan."""
+    empty = S(**BOWLS, green_bowl=(0.0, -0.6, 0))
+    for it in EVERY:
+        assert not it.feasible(empty.scene), it.name
+        assert not it.satisfied(empty) and it.score(empty) == 0.0 and it.plan(empty) is None, it.name
+
+
+def test_dev_tower_beside_a_bowl_and_warm_on_cool():
+    """"Stack all the blocks into one tower standing on the table right next to a bowl." /
+    "Put each warm-coloured block on top of a cool-coloured block." A pile in a bowl does not
+    stand next to it; a warm block on a cool block that lies in a bowl is on top of it."""
+    beside = intention("dev-tower-beside-a-bowl")
+    assert not beside.satisfied(PILED_IN_BOWL)
+    assert beside.satisfied(S(red_block=(-0.2 + BESIDE, -0.3, T), blue_block=(-0.2 + BESIDE, -0.3, T + UP), **BOWLS))
+    warm_on_cool = intention("dev-warm-on-cool")
+    assert warm_on_cool.satisfied(S(blue_block=(-0.2, -0.3, IN), red_block=(-0.2, -0.3, IN + UP), **BOWLS))
+    assert not warm_on_cool.satisfied(S(blue_block=(0, -0.6, T), red_block=(0.052, -0.6, T)))
