@@ -15,6 +15,8 @@ from activeintent.world import (
     PutAt,
     PutIn,
     PutNextTo,
+    PutOn,
+    Scene,
     WorldState,
     apply_plan,
     apply_skill,
@@ -163,6 +165,40 @@ def test_relations_orderings_and_exceptions_on_hand_built_states():
     assert stay.step_moves_away(start, apply_skill(start, shuffle)[0], shuffle)
     put = PutIn(block="green block", bowl="blue bowl")
     assert not stay.step_moves_away(start, apply_skill(start, put)[0], put)
+
+
+def test_a_pile_in_a_bowl_is_not_a_tower():
+    """Blocks put one after another into a bowl lie on each other but are piled in the bowl,
+    not stacked into a tower (as for the library's "stack")."""
+    tower = by_name("tower-warm-under-cool")
+    bowl = dict(green_bowl=(-0.2, -0.3, 0))
+    piled = S(red_block=(-0.2, -0.3, IN), blue_block=(-0.2, -0.3, IN + 0.04), **bowl)
+    assert not tower.satisfied(piled) and tower.score(piled) < 1.0
+    assert tower.satisfied(S(red_block=(0, -0.5, T), blue_block=(0, -0.5, T + 0.04), **bowl))
+    plan = tower.plan(piled)
+    states, failures = apply_plan(piled, plan)
+    assert not any(failures) and tower.satisfied(states[-1])
+    start = S(red_block=(-0.2, -0.3, IN), blue_block=(0.1, -0.6, T), **bowl)
+    onto_pile = PutOn(block="blue block", target="red block")
+    assert tower.step_moves_away(start, apply_skill(start, onto_pile)[0], onto_pile)
+
+
+def test_plans_never_crash_on_any_scene():
+    """Every plan returns steps or None, also on scenes where the intention is not feasible
+    (blocks only, bowls only, a single block)."""
+    scenes = [
+        ["red block", "blue block", "green block"],
+        ["red block", "orange block", "blue block", "green block"],
+        ["red bowl", "blue bowl", "green bowl"],
+        ["red block", "red bowl", "blue bowl"],
+        ["blue block", "red bowl", "blue bowl"],
+    ]
+    for objects in scenes:
+        for seed in range(3):
+            state = WorldState(positions=layout(Scene(objects=objects), seed))
+            for intention in heldout_intentions():
+                plan = intention.plan(state)
+                assert plan is None or isinstance(plan, list)
 
 
 @pytest.fixture(scope="module")

@@ -43,9 +43,9 @@ CASES = {
     "stack": (
         [
             S(red_block=(0, -0.5, T), blue_block=(0, -0.5, T + UP), green_block=(0.005, -0.5, T + 2 * UP)),
-            S(red_block=(-0.2, -0.3, IN), blue_block=(-0.2, -0.3, IN + UP), **BOWLS),  # tower in a bowl
         ],
         [
+            S(red_block=(-0.2, -0.3, IN), blue_block=(-0.2, -0.3, IN + UP), **BOWLS),  # piled in a bowl
             S(red_block=(0, -0.5, T), blue_block=(0, -0.5, T + UP), green_block=(0.2, -0.5, T)),
             S(red_block=(0, -0.5, T), blue_block=(0.052, -0.5, T), green_block=(0.104, -0.5, T)),
         ],

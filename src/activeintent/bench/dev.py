@@ -35,6 +35,7 @@ from activeintent.intentions.placement import (
     verified,
 )
 from activeintent.world import (
+    BOUNDS,
     COLOR_NAMES,
     COOL_COLORS,
     WARM_COLORS,
@@ -675,7 +676,13 @@ class TowerBesideBowl(Intention):
 # --- 9. a line in a region -------------------------------------------------------------------
 
 
-LEFT_CELLS = ("top left corner", "left side", "bottom left corner")
+# "Along the left edge": block centres at most 10 cm from the table's left edge (x = -0.3), so
+# a column in the left third but nearer the middle of the table does not count.
+LEFT_EDGE_X = BOUNDS[0][0] + 0.10
+
+
+def _by_left_edge(state: WorldState, block: str) -> bool:
+    return float(state.pos(block)[0]) <= LEFT_EDGE_X + 1e-9
 
 
 class LeftEdgeColumn(Intention):
@@ -685,7 +692,7 @@ class LeftEdgeColumn(Intention):
 
     def column_ok(self, state: WorldState, rel: Relations, members: Iterable[str]) -> bool:
         members = list(members)
-        return all(rel.table_position[b] in LEFT_CELLS for b in members) and self._column.line_ok(state, rel, members)
+        return all(_by_left_edge(state, b) for b in members) and self._column.line_ok(state, rel, members)
 
     def satisfied(self, state: WorldState) -> bool:
         return len(state.blocks) >= 2 and self.column_ok(state, relations(state), state.blocks)
@@ -695,7 +702,7 @@ class LeftEdgeColumn(Intention):
         if not n:
             return 0.0
         rel = relations(state)
-        flat = [b for b in state.blocks if on_table(rel, b) and rel.table_position[b] in LEFT_CELLS]
+        flat = [b for b in state.blocks if on_table(rel, b) and _by_left_edge(state, b)]
         for size in range(len(flat), 1, -1):
             if any(self.column_ok(state, rel, c) for c in combinations(flat, size)):
                 return size / n
@@ -707,7 +714,7 @@ class LeftEdgeColumn(Intention):
         if step.block not in after.blocks:
             return False
         rel = relations(after)
-        return not on_table(rel, step.block) or rel.table_position[step.block] not in LEFT_CELLS
+        return not on_table(rel, step.block) or not _by_left_edge(after, step.block)
 
     def feasible(self, scene: Scene) -> bool:
         return 2 <= len(scene.blocks) <= 4
@@ -724,7 +731,7 @@ class LeftEdgeColumn(Intention):
         rel = relations(state)
 
         def chains() -> Iterator[list[Skill]]:
-            anchors = [b for b in state.blocks if on_table(rel, b) and rel.table_position[b] in LEFT_CELLS]
+            anchors = [b for b in state.blocks if on_table(rel, b) and _by_left_edge(state, b)]
             for anchor in anchors:
                 others = top_first(state, [b for b in state.blocks if b != anchor])
                 for side in ("behind", "front"):
@@ -737,7 +744,7 @@ class LeftEdgeColumn(Intention):
 
         ordered = sorted(state.blocks, key=lambda b: state.pos(b)[1])
         (_, _), (y0, y1) = TABLE_INNER
-        lines = _line_plans(state, ordered, 1, (y0, y1), (-0.28, -0.12), step=0.02)
+        lines = _line_plans(state, ordered, 1, (y0, y1), (TABLE_INNER[0][0], LEFT_EDGE_X - 0.02), step=0.02)
         return _first_verified(self, state, [*chains(), *lines])
 
 

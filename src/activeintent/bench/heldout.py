@@ -35,6 +35,7 @@ from activeintent.intentions.placement import (
     is_warm,
     nearest_first,
     on_table,
+    standing_towers,
     top_first,
     towers,
     verified,
@@ -506,7 +507,7 @@ class TowerWarmUnderCool(_FromBenchmarkScenes, Intention):
         n = len(state.blocks)
         if not n:
             return 0.0
-        return max(self.good_height(state, t) for t in towers(state, relations(state))) / n
+        return max((self.good_height(state, t) for t in standing_towers(state, relations(state))), default=0) / n
 
     def satisfied(self, state: WorldState) -> bool:
         return bool(state.blocks) and self.score(state) >= 1.0 - EPS
@@ -521,8 +522,8 @@ class TowerWarmUnderCool(_FromBenchmarkScenes, Intention):
         below = rel.below(block)
         if below is None:
             return True  # building a tower only ever puts blocks on blocks
-        tower = next(t for t in towers(after, rel) if block in t)
-        return self.good_height(after, tower) <= tower.index(block)
+        tower = next((t for t in standing_towers(after, rel) if block in t), None)
+        return tower is None or self.good_height(after, tower) <= tower.index(block)
 
     def feasible(self, scene: Scene) -> bool:
         warm = [b for b in scene.blocks if is_warm(b)]
@@ -536,7 +537,7 @@ class TowerWarmUnderCool(_FromBenchmarkScenes, Intention):
         steps: list[Skill] = []
         current = state
         # Keep the best-started tower; everything else is taken down first (tops first).
-        keep = max(towers(state, relations(state)), key=lambda t: self.good_height(state, t))
+        keep = max(standing_towers(state, relations(state)), key=lambda t: self.good_height(state, t), default=[])
         keep = keep[: self.good_height(state, keep)]
         for b in top_first(state, state.blocks):
             if b in keep or _flat(relations(current), b):
@@ -894,6 +895,8 @@ class BowlsExceptRed(_FromBenchmarkScenes, BlockwiseIntention):
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
         if block == self.keep:
             return _park(state, block)
+        if not state.bowls:
+            return None
         counts = _bowl_counts(state, rel)
         # Spread the blocks over the bowls (short piles are steadier), nearest bowl on ties.
         bowl = min(state.bowls, key=lambda w: (counts[w], _distance(state, block, w)))

@@ -19,9 +19,12 @@ from activeintent.intentions.placement import (
     ROW_PITCH,
     TABLE_INNER,
     grid,
+    is_clear,
     is_warm,
     nearest_first,
     on_table,
+    park,
+    standing_towers,
     top_first,
     towers,
     verified,
@@ -38,6 +41,7 @@ from activeintent.world import (
     Scene,
     Skill,
     WorldState,
+    apply_skill,
     relations,
 )
 
@@ -185,19 +189,26 @@ class Stack(Intention):
     name = "stack"
     description = "Stack all the blocks into a single tower."
 
+    # A tower stands on the table: blocks piled in a bowl are in the bowl, not a tower
+    # (placement.standing_towers).
+
     def satisfied(self, state: WorldState) -> bool:
-        ts = towers(state, relations(state))
+        ts = standing_towers(state, relations(state))
         return len(ts) == 1 and len(ts[0]) == len(state.blocks) > 0
 
     def score(self, state: WorldState) -> float:
         n = len(state.blocks)
-        return len(towers(state, relations(state))[0]) / n if n else 0.0
+        return max((len(t) for t in standing_towers(state, relations(state))), default=0) / n if n else 0.0
 
     def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
         if self.score(after) < self.score(before) - 1e-9:
             return True
-        # Building a tower only ever puts blocks on blocks; anything else is a wasted move.
-        return step.block in after.blocks and relations(after).below(step.block) is None
+        # Building a tower only ever puts blocks on blocks of a tower standing on the table;
+        # anything else (the table, a bowl, a pile in a bowl) is a wasted move.
+        if step.block not in after.blocks:
+            return False
+        rel = relations(after)
+        return rel.below(step.block) is None or not any(step.block in t for t in standing_towers(after, rel))
 
     def feasible(self, scene: Scene) -> bool:
         return len(scene.blocks) >= 2
@@ -211,20 +222,34 @@ class Stack(Intention):
         if self.satisfied(state):
             return []
         rel = relations(state)
-        for keep in towers(state, rel):
-            steps: list[Skill] = []
-            top = keep[-1]
-            for b in top_first(state, [b for b in state.blocks if b not in keep]):
-                steps.append(PutOn(block=b, target=top))
-                top = b
-            if found := verified(self, state, steps):
+        for keep in standing_towers(state, rel):
+            if found := verified(self, state, _stack_onto(state, keep)):
+                return found
+        # No tower stands on the table (every block is in a bowl): set one block down first.
+        for base in top_first(state, [b for b in state.blocks if is_clear(rel, b)]):
+            if (step := park(state, base)) is None:
+                continue
+            after, _ = apply_skill(state, step)
+            if found := verified(self, state, [step, *_stack_onto(after, [base])]):
                 return found
         return None
+
+
+def _stack_onto(state: WorldState, keep: list[str]) -> list[Skill]:
+    """Put every block not in ``keep`` onto its top, topmost blocks first."""
+    steps: list[Skill] = []
+    top = keep[-1]
+    for b in top_first(state, [b for b in state.blocks if b not in keep]):
+        steps.append(PutOn(block=b, target=top))
+        top = b
+    return steps
 
 
 class TwoTowers(Intention):
     name = "two-towers"
     description = "Stack the blocks into two towers of (nearly) equal height."
+
+    # Towers stand on the table; blocks piled in a bowl are not a tower (see Stack).
 
     @staticmethod
     def heights(n: int) -> tuple[int, int]:
@@ -232,16 +257,16 @@ class TwoTowers(Intention):
 
     def satisfied(self, state: WorldState) -> bool:
         n = len(state.blocks)
-        ts = towers(state, relations(state))
+        ts = standing_towers(state, relations(state))
         return n >= 2 and len(ts) == 2 and (len(ts[0]), len(ts[1])) == self.heights(n)
 
     def score(self, state: WorldState) -> float:
         n = len(state.blocks)
         if not n:
             return 0.0
-        ts = towers(state, relations(state))
+        ts = standing_towers(state, relations(state))
         h1, h2 = self.heights(n)
-        got = min(len(ts[0]), h1) + (min(len(ts[1]), h2) if len(ts) > 1 else 0)
+        got = (min(len(ts[0]), h1) if ts else 0) + (min(len(ts[1]), h2) if len(ts) > 1 else 0)
         return got / n
 
     def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
@@ -252,8 +277,8 @@ class TwoTowers(Intention):
         rel = relations(after)
         if rel.below(step.block) is None:
             return True
-        tower = next(t for t in towers(after, rel) if step.block in t)
-        return len(tower) > self.heights(len(after.blocks))[0]
+        tower = next((t for t in standing_towers(after, rel) if step.block in t), None)
+        return tower is None or len(tower) > self.heights(len(after.blocks))[0]
 
     def feasible(self, scene: Scene) -> bool:
         return len(scene.blocks) >= 4
@@ -268,14 +293,29 @@ class TwoTowers(Intention):
         if self.satisfied(state):
             return []
         h1, h2 = self.heights(n)
-        ts = towers(state, relations(state))
-        for i, j in combinations(range(min(len(ts), 4)), 2):
-            keep = [ts[i][:h1], ts[j][:h2]]
-            kept = set(keep[0]) | set(keep[1])
-            tops = [keep[0][-1], keep[1][-1]]
-            sizes = [len(keep[0]), len(keep[1])]
+        rel = relations(state)
+        ts = standing_towers(state, rel)[:4]
+        # Keep the bottoms of two standing towers, or of one (or none) and set bases down.
+        keeps = [[ts[i], ts[j]] for i, j in combinations(range(len(ts)), 2)] + [[t] for t in ts] + [[]]
+        for keep in keeps:
+            kept = [t[:h] for t, h in zip(keep, (h1, h2), strict=False)]
             steps: list[Skill] = []
-            for b in top_first(state, [b for b in state.blocks if b not in kept]):
+            current = state
+            while len(kept) < 2:  # a new base: a clear block from a bowl or a tall tower
+                taken = {b for t in kept for b in t}
+                free = [b for b in top_first(current, current.blocks) if b not in taken and is_clear(relations(current), b)]
+                step = next((s for b in free if (s := park(current, b)) is not None), None)
+                if step is None:
+                    break
+                current, _ = apply_skill(current, step)
+                steps.append(step)
+                kept.append([step.block])
+            if len(kept) < 2:
+                continue
+            tops = [kept[0][-1], kept[1][-1]]
+            sizes = [len(kept[0]), len(kept[1])]
+            taken = {b for t in kept for b in t}
+            for b in top_first(current, [b for b in current.blocks if b not in taken]):
                 k = 0 if sizes[0] < h1 else 1
                 steps.append(PutOn(block=b, target=tops[k]))
                 tops[k], sizes[k] = b, sizes[k] + 1

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from activeintent.world import BOUNDS, PutAt, Relations, Skill, WorldState, apply_plan
+from activeintent.world import BOUNDS, PutAt, Relations, Skill, WorldState, apply_plan, relations
 from activeintent.world.predict import SkillFailure, apply_skill, target_position
 from activeintent.world.scene import color_of
 
@@ -39,6 +39,15 @@ def towers(state: WorldState, rel: Relations) -> list[list[str]]:
             seen.add(top)
         result.append(chain)
     return sorted(result, key=len, reverse=True)
+
+
+def standing_towers(state: WorldState, rel: Relations) -> list[list[str]]:
+    """The towers whose base rests on the table, tallest first.
+
+    Blocks put in a bowl one after another lie on each other (world.relations says `on`), but
+    they are piled in the bowl, not stacked into a tower: a sentence about towers means these.
+    """
+    return [t for t in towers(state, rel) if on_table(rel, t[0])]
 
 
 def on_table(rel: Relations, block: str) -> bool:
@@ -104,6 +113,12 @@ def verified(intention: Intention, state: WorldState, steps: list[Skill]) -> lis
     """``steps`` if the world model says they satisfy ``intention`` from ``state``, else None."""
     final = run(state, steps)
     return steps if final is not None and intention.satisfied(final) else None
+
+
+def park(state: WorldState, block: str) -> PutAt | None:
+    """Put ``block`` on a free spot of the table near where it is (alone, not in a bowl)."""
+    spots = nearest_first(grid(*TABLE_INNER, step=0.05), state.pos(block)[:2])
+    return free_spot(state, block, spots, accept=lambda after: on_table(relations(after), block))
 
 
 def can_do(state: WorldState, step: Skill) -> bool:
