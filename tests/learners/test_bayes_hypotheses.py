@@ -37,7 +37,7 @@ def test_prior_is_a_normalised_description_length_prior(hyps):
     assert (lp[0] - lp[-1]) == pytest.approx((bits[-1] - bits[0]) * math.log(2))
     by_name = {h.name: h for h in hyps}
     assert by_name["all:tower"].bits < by_name["all:tower-on[red]"].bits
-    assert by_name["all:tower"].bits < by_name["warm:tower@table+cool:in-any-bowl"].bits
+    assert by_name["all:tower"].bits < by_name["warm:tower+cool:in-any-bowl"].bits
 
 
 def test_every_planner_satisfies_its_hypothesis_in_feasible_scenes(hyps):

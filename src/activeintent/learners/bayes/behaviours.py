@@ -306,15 +306,11 @@ class Tower(Behaviour):
     family = "tower"
     variants = 3
 
-    def __init__(self, table_only: bool = False):
-        self.table_only = table_only
+    def __init__(self, table_only: bool = True):
+        self.table_only = table_only  # a tower stands on the table: a pile in a bowl is none
 
     def phrase(self, s: str) -> str:
-        return f"{s} are stacked into one tower" + (" standing on the table" if self.table_only else "")
-
-    @property
-    def key(self) -> str:
-        return super().key + ("@table" if self.table_only else "")
+        return f"{s} are stacked into one tower"
 
     def moved_ok(self, fb: Facts, fa: Facts, group: Group, b: str) -> bool:
         # Building a tower only ever puts blocks on blocks.

@@ -192,7 +192,7 @@ ALL_FAMILIES: list[tuple[str, list[bh.Behaviour]]] = [
     ("in-any-bowl", [bh.InAnyBowl()]),
     ("on-table", [bh.OnTable()]),
     ("next-to-same-bowl", [bh.NextToSameBowl()]),
-    ("tower", [bh.Tower(table_only=True)]),  # a pile in a bowl is no tower
+    ("tower", [bh.Tower()]),
     ("distinct-corners", [bh.DistinctCorners()]),
     ("row", [bh.Row()]),
     ("column", [bh.Column()]),
