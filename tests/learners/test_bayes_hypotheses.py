@@ -132,3 +132,18 @@ def agreement_states(intention, hyps, n_scenes: int = 6, seed: int = 0) -> list:
                 out.append(states[-1])
     return out
 
+
+@pytest.mark.parametrize("name, objects, seed", [
+    ("all:region[bottom right corner]", ["cyan block", "purple block", "red block", "pink bowl", "yellow bowl"], 1113),
+    ("warm:region[bottom right corner]", ["orange block", "yellow block", "red bowl", "green bowl", "brown bowl"], 1344),
+])
+def test_a_bowl_in_a_corner_cell_leaves_room_for_the_blocks(hyps, name, objects, seed):
+    """A bowl covered most of the coarse grid points of the corner cell: the planner found no
+    plan although the scene is feasible (there is room between the grid points)."""
+    from activeintent.world import Scene
+
+    h = {h.name: h for h in hyps}[name]
+    scene = Scene(objects=objects)
+    state = WorldState(positions=layout(scene, seed))
+    assert h.feasible(scene)
+    assert plan_failure(h, state) is None
