@@ -61,6 +61,9 @@ CORE_DEPENDENCIES: dict[str, Dependency] = {
     ),
     "pybullet": Dependency(lambda: _importable("pybullet"), ("pybullet", "activeintent.sim")),
     "chromium": Dependency(_chromium, ("chromium", "playwright")),
+    # the Ray backend's tests (tests/bench/test_bench_ray.py); ray is in the dev extra. The words
+    # are quoted as pytest.importorskip quotes them: a bare "ray" would match "array", "gray", …
+    "ray": Dependency(lambda: _importable("ray"), ("'ray'", "ray[default]")),
 }
 
 

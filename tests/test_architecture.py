@@ -1,5 +1,5 @@
 """The layering the design promises, checked on the source: data flows one way, learners and
-users never see each other, nothing above world/ imports the simulator, no import cycles."""
+users never see each other, nothing above world/ imports the simulator, no import cycles beyond the known ones (KNOWN_IMPORT_CYCLES)."""
 
 from __future__ import annotations
 
@@ -16,15 +16,10 @@ def module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def imports(path: Path, top_level_only: bool) -> set[str]:
-    """activeintent modules imported by ``path`` (all imports, or only those run at import time)."""
-    tree = ast.parse(path.read_text())
-    nodes = tree.body if top_level_only else list(ast.walk(tree))
-    if top_level_only:  # imports under `if TYPE_CHECKING:` / try blocks at module level count too
-        nodes = [n for stmt in tree.body for n in ast.walk(stmt)
-                 if not isinstance(stmt, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef)]
+def imports(path: Path) -> set[str]:
+    """activeintent modules imported anywhere in ``path`` (``if TYPE_CHECKING:`` blocks too)."""
     out = set()
-    for node in nodes:
+    for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.Import):
             out |= {a.name for a in node.names if a.name.startswith("activeintent")}
         elif isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("activeintent"):
@@ -45,24 +40,59 @@ MODULES = {module_name(p): p for p in SRC.rglob("*.py")}
 ])
 def test_layering(package, forbidden):
     bad = [(name, imp) for name, path in MODULES.items() if name.startswith(package)
-           for imp in imports(path, top_level_only=False) if imp.startswith(forbidden)]
+           for imp in imports(path) if imp.startswith(forbidden)]
     assert not bad, f"{package} must not import {forbidden}: {bad}"
 
 
-def test_no_import_cycles():
-    graph = {name: {m for m in imports(path, top_level_only=True) if m in MODULES and m != name}
+def _is_type_checking(node: ast.AST) -> bool:
+    test = node.test if isinstance(node, ast.If) else None
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (
+        isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
+
+
+def runtime_imports(path: Path) -> set[str]:
+    """activeintent modules ``path`` may import when it runs: module level, inside functions and
+    methods (lazy imports run on first call) and in try blocks. Imports under
+    ``if TYPE_CHECKING:`` are left out: they never run, so they cannot form a cycle at run time
+    (their ``else:`` branch does run and counts)."""
+    out: set[str] = set()
+
+    def visit(node: ast.AST) -> None:
+        if isinstance(node, ast.If) and _is_type_checking(node):
+            for child in node.orelse:
+                visit(child)
+            return
+        if isinstance(node, ast.Import):
+            out.update(a.name for a in node.names if a.name.startswith("activeintent"))
+        elif isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("activeintent"):
+            out.add(node.module)
+            out.update(f"{node.module}.{a.name}" for a in node.names)
+        for child in ast.iter_child_nodes(node):
+            visit(child)
+
+    visit(ast.parse(path.read_text()))
+    return out
+
+
+def import_graph() -> dict[str, set[str]]:
+    graph = {name: {m for m in runtime_imports(path) if m in MODULES and m != name}
              for name, path in MODULES.items()}
     # a package's __init__ importing its own submodules is not a cycle of meaning
     for name in graph:
         graph[name] = {m for m in graph[name] if not (MODULES[name].name == "__init__.py" and m.startswith(name + "."))}
-    index, low, stack, on, cycles, counter = {}, {}, [], set(), [], [0]
+    return graph
+
+
+def import_cycles(graph: dict[str, set[str]]) -> set[frozenset[str]]:
+    """The strongly connected components of more than one module (Tarjan)."""
+    index, low, stack, on, cycles, counter = {}, {}, [], set(), set(), [0]
 
     def visit(v):
         index[v] = low[v] = counter[0]
         counter[0] += 1
         stack.append(v)
         on.add(v)
-        for w in graph[v]:
+        for w in sorted(graph[v]):
             if w not in index:
                 visit(w)
                 low[v] = min(low[v], low[w])
@@ -77,12 +107,64 @@ def test_no_import_cycles():
                 if w == v:
                     break
             if len(comp) > 1:
-                cycles.append(sorted(comp))
+                cycles.add(frozenset(comp))
 
-    for v in graph:
+    for v in sorted(graph):
         if v not in index:
             visit(v)
-    assert not cycles, f"import cycles: {cycles}"
+    return cycles
+
+
+# Import cycles that exist today, closed only by lazy (function-level) imports or by imports
+# that run at load time (a registry filling itself). They are known debt, to be removed by a
+# later issue; remove an entry when its cycle is broken (the test below fails while a listed
+# cycle no longer exists, so this list only shrinks). Any cycle not listed here fails.
+KNOWN_IMPORT_CYCLES: frozenset[frozenset[str]] = frozenset({
+    # signals/base.register_builtin(), run when base loads, imports the built-in signals; they import base
+    frozenset({"activeintent.signals.base", "activeintent.signals.preference", "activeintent.signals.stop"}),
+    # act/base imports the executors inside make_executor (and the parser's fallback); they import base
+    frozenset({"activeintent.act.base", "activeintent.act.cap", "activeintent.act.parse", "activeintent.act.plan"}),
+    # bench/runner imports execute_ray inside a function; the backends import runner's
+    # protocol_fields and run_item inside functions
+    frozenset({"activeintent.bench.runner", "activeintent.bench.backends"}),
+    # the registry's lang-* entries import lang/learner lazily; its lang_method imports the
+    # registry's LearnerContext and Method inside the function
+    frozenset({"activeintent.learners.registry", "activeintent.learners.lang.learner"}),
+})
+
+
+def test_no_import_cycles_beyond_the_known_ones():
+    cycles = import_cycles(import_graph())
+    new = [sorted(c) for c in cycles - KNOWN_IMPORT_CYCLES]
+    assert not new, f"new import cycles (function-level imports count): {new}"
+    gone = [sorted(c) for c in KNOWN_IMPORT_CYCLES - cycles]
+    assert not gone, f"these known cycles no longer exist: remove them from KNOWN_IMPORT_CYCLES: {gone}"
+
+
+def test_the_cycle_check_sees_lazy_imports_and_ignores_type_checking_blocks(tmp_path):
+    code = (
+        "from typing import TYPE_CHECKING\n"
+        "import activeintent.a\n"
+        "if TYPE_CHECKING:\n"
+        "    from activeintent.b import B\n"
+        "else:\n"
+        "    import activeintent.c\n"
+        "def f():\n"
+        "    from activeintent.d import g\n"
+        "class K:\n"
+        "    def m(self):\n"
+        "        import activeintent.e\n"
+        "try:\n"
+        "    import activeintent.h\n"
+        "except ImportError:\n"
+        "    pass\n"
+    )
+    (tmp_path / "m.py").write_text(code)
+    found = runtime_imports(tmp_path / "m.py")
+    assert found == {"activeintent.a", "activeintent.c", "activeintent.d", "activeintent.d.g",
+                     "activeintent.e", "activeintent.h"}
+    graph = {"x": {"y"}, "y": {"z"}, "z": {"x"}, "w": {"x"}}
+    assert import_cycles(graph) == {frozenset({"x", "y", "z"})}
 
 
 def test_one_episode_loop_and_no_proxies():

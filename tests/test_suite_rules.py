@@ -75,6 +75,39 @@ def test_ci_turns_a_module_level_skip_into_a_collection_error(pytester, monkeypa
     assert result.ret != pytest.ExitCode.OK
 
 
+RAY_MISSING = '''
+import pytest
+
+ray = pytest.importorskip("ray")  # as tests/bench/test_bench_ray.py does
+
+def test_uses_ray():
+    pass
+'''
+
+
+def test_ci_turns_a_missing_ray_into_a_failure_like_every_core_dependency(pytester, monkeypatch, all_present):
+    """ray is in the dev extra: under CI the Ray backend's tests must not skip for want of it."""
+    import sys
+
+    assert "ray" in suite_rules.CORE_DEPENDENCIES
+    monkeypatch.setitem(sys.modules, "ray", None)  # `import ray` fails, as without the package
+    monkeypatch.setenv("CI", "true")
+    pytester.makepyfile(test_ray_missing=RAY_MISSING)
+    result = _run(pytester)
+    result.assert_outcomes(errors=1)
+    result.stdout.fnmatch_lines(["*missing core dependency (ray)*"])
+    assert result.ret != pytest.ExitCode.OK
+    monkeypatch.delenv("CI")
+    _run(pytester).assert_outcomes(skipped=1)  # without CI it skips, as before
+    assert suite_rules.dependency_named_in("an array of gray strays") is None
+
+
+def test_the_ray_tests_skip_on_exactly_the_probe_of_a_core_dependency():
+    """The skip tests/bench/test_bench_ray.py would give without ray names a core dependency."""
+    reason = "could not import 'ray': No module named 'ray'"  # pytest.importorskip's words
+    assert suite_rules.dependency_named_in(reason) == "ray"
+
+
 @pytest.mark.parametrize("ci", [None, ""])
 def test_without_ci_such_tests_skip(pytester, monkeypatch, all_present, ci):
     if ci is None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -34,6 +35,41 @@ def test_wilson_interval_matches_known_values():
     lo, hi = wilson(3, 5)
     assert round(lo, 3) == 0.231 and round(hi, 3) == 0.882
     assert wilson(0, 5)[0] == 0.0 and wilson(5, 5)[1] == 1.0
+
+
+CELL = re.compile(r"([0-9.]+) \[([0-9.]+), ([0-9.]+)\] \(n=(\d+)\)")
+
+
+def test_report_intervals_are_wilson_intervals_of_the_episodes(tmp_path):
+    """Every printed cell is mean [Wilson interval of Σ success over n] (n=n), n = the scored
+    episodes of that cell (errors and unscored episodes left out), for each intention and 'all'."""
+    successes = {("bayes-stop", "stack"): [1.0, 0.5, 0.8, 0.9, 0.7, 1.0],
+                 ("bayes-stop", "color-match"): [0.2, 0.0, 0.4],
+                 ("zero-signal", "stack"): [0.1, 0.3, 0.0, 0.0],
+                 ("zero-signal", "color-match"): [0.6, 0.9, 0.75, 0.3, 0.5]}
+    records = []
+    for (method, intention), values in successes.items():
+        for trial, v in enumerate(values):
+            records.append({"method": method, "intention": intention, "trial": trial, "success": v,
+                            "success_at": [0.0, v], "signals_used": 1, "answers": {"stop": 1}})
+        records.append({"method": method, "intention": intention, "trial": 99, "error": "boom", "success": None})
+        records.append({"method": method, "intention": intention, "trial": 98, "success": None})
+    text = write_report(records, METHODS, INTENTIONS, tmp_path, {"env": "symbolic", "budget": 1}).read_text()
+    checked = 0
+    for method in METHODS:
+        row = next(line for line in text.splitlines() if line.startswith(f"| {method} |")
+                   or line.startswith(f"| *{method}* (baseline) |"))
+        cells = CELL.findall(row)
+        assert len(cells) == len(INTENTIONS) + 1, row
+        columns = [successes[(method, i)] for i in INTENTIONS]
+        columns.append([v for values in columns for v in values])  # the **all** column
+        for (mean, lo, hi, n), values in zip(cells, columns, strict=True):
+            want_lo, want_hi = wilson(sum(values), len(values))
+            assert int(n) == len(values)
+            assert float(mean) == pytest.approx(round(sum(values) / len(values), 2), abs=1e-9)
+            assert (float(lo), float(hi)) == pytest.approx((round(want_lo, 2), round(want_hi, 2)), abs=1e-9), row
+            checked += 1
+    assert checked == 6
 
 
 def test_trial_seeds():

@@ -158,3 +158,40 @@ def test_explain_finds_the_goal_of_a_sentence():
     got = explain("Put every block in the bowl of its own colour")
     assert got["matches"][0]["key"] == "every all: in-bowl:same"
     assert not explain("Juggle while singing loudly")["expressible"]
+
+
+def test_every_sampled_goal_of_the_space_gets_a_plan_wherever_it_is_called_feasible():
+    """Per goal, no tolerance, over a fixed bank of seeded scenes and layouts, for a sample of
+    the learner's space: a goal the space's judge calls feasible gets plans that satisfy it, or
+    the planner's failure makes the judge call it infeasible there from then on; a goal as a
+    user's intention (planner.feasible) is feasible exactly where its plan delivers it."""
+    from activeintent.learners.lang.hypotheses import lang_space
+
+    goals = lang_space().goals[::60]  # 50 goals, simplest to longest
+    space = LangSpace(goals)  # a private copy: the planner's verdicts stay out of the shared space
+    rng = np.random.default_rng(17)
+    bank = [random_scene(rng) for _ in range(12)]
+    bank = [(scene, WorldState(positions=layout(scene, 700 + k))) for k, scene in enumerate(bank)]
+    failures, planned = [], 0
+    for scene, state in bank:
+        objects = tuple(scene.objects)
+        for i, goal in enumerate(goals):
+            if not space.feasible(objects)[i]:
+                continue
+            plans = space.plans(i, state)
+            if not plans and space.feasible(objects)[i]:
+                failures.append((goal.key, objects, "called feasible after the planner failed"))
+            for p in plans:
+                planned += 1
+                end = planner.run(state, p)
+                if end is None or not goal.holds(facts(end)):
+                    failures.append((goal.key, objects, "plan does not satisfy"))
+        base = WorldState(positions=layout(scene, planner.LAYOUT_SEED))
+        for goal in goals[::5]:
+            if GoalIntention(goal).feasible(scene):
+                p = planner.plan(goal, base)
+                end = None if p is None else planner.run(base, p)
+                if end is None or not GoalIntention(goal).satisfied(end):
+                    failures.append((goal.key, objects, "feasible intention without a plan"))
+    assert not failures, failures
+    assert planned >= 100

@@ -174,3 +174,48 @@ def test_an_episode_does_not_depend_on_the_episodes_run_before_it_in_the_process
     first = run("align")
     run("stack")
     assert run("align") == first
+
+
+def test_a_new_lang_learner_forgets_the_planner_failures_marked_in_the_shared_space():
+    """Pins ``sp.reset()`` in LangLearner.__init__: goals an earlier episode's planner failed
+    on are marked infeasible in the process-wide space; a new learner starts from the static
+    checks only, and its episode is the one it would be with a clean space."""
+    from activeintent.learners.lang.hypotheses import lang_space
+    from activeintent.protocol import trial_seeds
+    from activeintent.runner import RunOptions, build_episode
+
+    shared = lang_space()
+    seed, test_seed = trial_seeds(0, "align", 0)
+    opts = RunOptions(method="lang-stop", intention="align", env="symbolic", llm="none", budget=3,
+                      video="none", seed=seed, test_seed=test_seed, prior="uniform", curve=False)
+
+    class Rounds(list):
+        def answered(self, log):
+            self.append(log)
+
+    def run():
+        rounds = Rounds()
+        result = build_episode(opts, observers=[rounds]).run()
+        assert result.error is None, result.error
+        return result, rounds
+
+    clean, clean_rounds = run()
+    scenes = {tuple(r.scene) for r in clean_rounds} | {tuple(t.scene) for t in clean.tests}
+    # As an earlier episode's planner failures would: every other goal infeasible in these scenes.
+    for objects in scenes:
+        shared.failed.setdefault(objects, set()).update(range(0, len(shared.goals), 2))
+    some = next(iter(scenes))
+    assert not shared.feasible(some)[::2].any()  # the marks are in effect before the learner is built
+
+    learner = LangLearner("stop")
+    assert learner.base == [shared]
+    for objects in scenes:
+        assert (learner.judge.feasible(objects) == shared.compiled.possible(objects)).all()
+
+    for objects in scenes:
+        shared.failed.setdefault(objects, set()).update(range(0, len(shared.goals), 2))
+    again, again_rounds = run()
+    assert (again.success_at, again.final_z, again.final_goal, again.answers) == (
+        clean.success_at, clean.final_z, clean.final_goal, clean.answers)
+    assert [(r.scene, r.plans, r.answer, r.why) for r in again_rounds] == [
+        (r.scene, r.plans, r.answer, r.why) for r in clean_rounds]

@@ -18,6 +18,7 @@ from activeintent.learners.bayes.planning import (
     nearest_points,
     put_free,
     region_points,
+    region_spots,
 )
 from activeintent.world import PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState, apply_skill
 from activeintent.world.scene import color_of
@@ -255,7 +256,7 @@ class InRegion(Behaviour):
         return in_region(self.param, f.xy[b]) if self.param in HALVES else f.cell[b] == self.param
 
     def target(self, state, group, b, variant):
-        got = put_free(state, b, region_points(self.param))
+        got = put_free(state, b, region_spots(self.param))
         return got[1] if got else None
 
 
@@ -280,9 +281,11 @@ class DistinctCorners(Behaviour):
     def target(self, state, group, b, variant):
         f = facts(state)
         taken = {self._corner(f, o) for o in group if o != b}
-        for corner in self.corners:
-            if corner not in taken and (got := put_free(state, b, region_points(corner))):
-                return got[1]
+        free = [c for c in self.corners if c not in taken]
+        for points in (region_points, region_spots):  # the fine points only once no corner has a coarse one
+            for corner in free:
+                if got := put_free(state, b, points(corner)):
+                    return got[1]
         return None
 
 

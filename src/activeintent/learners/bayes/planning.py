@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from activeintent.world import BOUNDS, PutAt, Skill, SkillFailure, WorldState, apply_skill
@@ -34,13 +36,27 @@ def in_region(region: str, xy: tuple[float, float]) -> bool:
     return table_position_name(xy) == region
 
 
-def region_points(region: str) -> list[tuple[float, float]]:
-    pts = [p for p in GRID if in_region(region, p)]
+def region_points(region: str, step: float = GRID_STEP) -> list[tuple[float, float]]:
+    """Grid points of ``region``, nearest its centre first."""
+    pts = [p for p in (GRID if step == GRID_STEP else _fine_grid(step)) if in_region(region, p)]
     if not pts:
         return []
     cx = float(np.mean([p[0] for p in pts]))
     cy = float(np.mean([p[1] for p in pts]))
     return sorted(pts, key=lambda p: (p[0] - cx) ** 2 + (p[1] - cy) ** 2)
+
+
+@lru_cache(maxsize=4)
+def _fine_grid(step: float) -> tuple[tuple[float, float], ...]:
+    return tuple(grid_points(step))
+
+
+def region_spots(region: str) -> list[tuple[float, float]]:
+    """Where a block may be put down in ``region``: the usual grid points, then (when a bowl or
+    other blocks cover those of a small cell) the points of a grid twice as fine."""
+    coarse = region_points(region)
+    seen = set(coarse)
+    return coarse + [p for p in region_points(region, GRID_STEP / 2) if p not in seen]
 
 
 def step_ok(state: WorldState, step: Skill) -> WorldState | None:
