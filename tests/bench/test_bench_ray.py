@@ -26,7 +26,7 @@ COMPARED = ("method", "intention", "trial", "seed", "success_at", "signals_used"
 
 def tiny(backend: str = "local", **changes) -> BenchOptions:
     options = BenchOptions(methods=METHODS, intentions=INTENTIONS, trials=1, seed=5, jobs=2, backend=backend,
-                           run=RunOptions(budget=2, llm="none", env="symbolic", video="none"))
+                           run=RunOptions(budget=2, test_pool=10, llm="none", env="symbolic", video="none"))
     return options.model_copy(update=changes)
 
 

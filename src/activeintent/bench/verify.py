@@ -4,8 +4,8 @@ numbers cannot drift from the code silently.
 
 Whole records are compared, except what describes the run rather than the episode: wall time
 and its split, provenance (commit, versions, CPU, date) and tracebacks. A folder written under
-an older record format is refused (it was made by other code: regenerate it), not reported as
-different.
+an older record format, or one that says in ``NOT-VERIFIED.md`` why it cannot be re-run (e.g. it
+needs a model server), is refused, not reported as different.
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ import typer
 
 from activeintent.protocol import FORMAT_VERSION
 
+NOT_VERIFIED = "NOT-VERIFIED.md"  # a folder's own word on why it cannot be re-run
 NOT_COMPARED = frozenset({"wall_s", "time_split", "provenance", "traceback"})
 
 
@@ -62,6 +63,9 @@ def verify(folder: Path, sample: int, methods: list[str] | None = None) -> list[
     from activeintent.bench.runner import BenchOptions, WorkItem, run_item
     from activeintent.records import read_results
 
+    note = folder / NOT_VERIFIED
+    if note.is_file():
+        raise StaleFolder(f"{folder} cannot be verified: {note.read_text().strip().splitlines()[0].lstrip('# ')}")
     options = BenchOptions.model_validate_json((folder / "bench.json").read_text())
     records = [r for r in read_results(folder / "results.jsonl") if not r.get("error")]
     old = sorted({r.get("format") for r in records if r.get("format") != FORMAT_VERSION}, key=str)
