@@ -61,8 +61,11 @@ def test_every_learner_assumes_the_signals_learner_model_never_the_users(user, s
         assert hasattr(learner, "model"), f"{name}: the learner's assumed observation model is missing"
         assert learner.model == sig.learner_model(), f"{name} does not assume the signal's learner model"
         assert type(learner.model) is type(simulated.model)
-        # the user's parameters differ in these presets, so equal values above mean they were not copied
-        assert learner.model != simulated.model, f"{name} assumes the simulated user's true parameters"
+        if type(sig).__module__.startswith("activeintent."):
+            # the package's signals give users of these presets other parameters than the learner
+            # assumes, so equal values would mean they were copied (a plug-in signal registered by
+            # another test, e.g. examples/my_signal.py, may give both the same values)
+            assert learner.model != simulated.model, f"{name} assumes the simulated user's true parameters"
         theirs = {id(o) for o in containers(simulated.model)} | {id(o) for o in containers(simulated.profile)}
         shared = [type(o).__name__ for o in containers(learner.model) if id(o) in theirs]
         assert not shared, f"{name} shares objects with the simulated user's model: {shared}"
