@@ -1,5 +1,6 @@
 """Bit-for-bit episodes on every machine: the same bench folder re-run in fresh processes under
-other BLAS kernels and thread counts, and with an empty cache directory, gives identical records
+other BLAS kernels and thread counts, other string-hash seeds (a set iterated in a planner once
+made episodes follow PYTHONHASHSEED) and with an empty cache directory, gives identical records
 (everything but wall time, its split and provenance)."""
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ BENCH = ["bench", "--methods", "bayes-stop,lang-preference,zero-signal", "--inte
 
 def _cli(args: list[str], cache: Path, **env: str) -> subprocess.CompletedProcess:
     full = {**os.environ, "ACTIVEINTENT_CACHE": str(cache), **env}
-    for key in ("OPENBLAS_CORETYPE", "OPENBLAS_NUM_THREADS"):
+    for key in ("OPENBLAS_CORETYPE", "OPENBLAS_NUM_THREADS", "PYTHONHASHSEED"):
         if key not in env:
             full.pop(key, None)
     return subprocess.run([sys.executable, "-m", "activeintent.cli", *args], capture_output=True, text=True,
@@ -35,13 +36,13 @@ def _cli(args: list[str], cache: Path, **env: str) -> subprocess.CompletedProces
 @pytest.mark.slow
 def test_episodes_are_identical_under_other_blas_kernels_threads_and_an_empty_cache(tmp_path):
     folder = tmp_path / "bench"
-    made = _cli([*BENCH, "--out", str(folder)], tmp_path / "cache-a")
+    made = _cli([*BENCH, "--out", str(folder)], tmp_path / "cache-a", PYTHONHASHSEED="0")
     assert made.returncode == 0, made.stderr[-2000:]
     lines = [json.loads(x) for x in (folder / "results.jsonl").read_text().splitlines()]
     assert len(lines) == 6 and not any(r.get("error") for r in lines)
-    for kernel, threads in [("Haswell", "1"), ("Prescott", "2")]:
+    for kernel, threads, hashing in [("Haswell", "1", "1"), ("Prescott", "2", "2")]:
         again = _cli(["bench-verify", str(folder), "--sample", "6"], tmp_path / f"cache-{kernel}",
-                     OPENBLAS_CORETYPE=kernel, OPENBLAS_NUM_THREADS=threads)
+                     OPENBLAS_CORETYPE=kernel, OPENBLAS_NUM_THREADS=threads, PYTHONHASHSEED=hashing)
         assert again.returncode == 0, f"{kernel}, {threads} thread(s):\n{again.stdout[-4000:]}{again.stderr[-2000:]}"
         assert "6 re-run episodes agree" in again.stdout
         assert any((tmp_path / f"cache-{kernel}").iterdir()), "the empty cache directory was not used"

@@ -1,7 +1,8 @@
 """EIG questions beat random questions on the same episodes (docs/results/eig-vs-random: paper and
 dev suites, exact users, 8 trials): the paired 95 % interval of the difference in area under
-success@k lies above 0 for both signals, and a sample re-run from the code agrees with the folder
-(so a learner that asked at random would fail here)."""
+success@k lies above 0 (for preference questions; for stop questions it does not yet: a marked
+finding), and a sample re-run from the code agrees with the folder (so a learner that asked at
+random would fail here)."""
 
 from __future__ import annotations
 
@@ -28,7 +29,14 @@ def test_the_folder_holds_the_protocol_the_claim_names(records):
     assert {r["trial"] for r in records} >= set(range(8))
 
 
-@pytest.mark.parametrize("eig,random", PAIRED)
+# A finding, not a loosened test: with exact users the stop learner's EIG questions are not
+# measurably better than random ones on these suites (+0.015 [-0.015, +0.045], n = 112, at
+# 3b8da2a); the fix belongs in the learner (issue "Questions worth a person's answer"). strict:
+# this test fails as soon as the claim holds, so the mark cannot outlive the finding.
+STOP_FINDING = pytest.mark.xfail(strict=True, reason="EIG stop questions do not yet beat random ones (exact users)")
+
+
+@pytest.mark.parametrize("eig,random", [pytest.param(*PAIRED[0], marks=STOP_FINDING), PAIRED[1]])
 def test_eig_questions_beat_random_ones_on_the_same_episodes(records, eig, random):
     d = paired_difference(records, eig, random)
     assert d is not None and d["n"] >= 8 * 14

@@ -674,7 +674,8 @@ class Cluster(Structure):
         if not flat:
             return []
         core = max((self._comp(f, g, b) for b in flat), key=len)
-        return [PutNextTo(block=b, target=t) for b in g if b not in core for t in core]
+        # in the group's order: iterating the set would follow Python's per-process string hashing
+        return [PutNextTo(block=b, target=t) for b in g if b not in core for t in g if t in core]
 
 
 CORNERS = ("back left corner", "back right corner", "front left corner", "front right corner")
