@@ -3,14 +3,13 @@ shown in at least 5 of the test scenes scored at k = K, in every trial a default
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from activeintent.episode import EpisodeSeeds
 from activeintent.protocol import (
     DEFAULT_TEST_POOL,
     DEFAULT_TEST_SCENES,
-    sample_test_scene,
+    draw_test_scenes,
     trial_seeds,
 )
 from activeintent.suites import SUITE_NAMES, resolve, suite
@@ -19,14 +18,10 @@ MIN_SCORED = 5
 
 
 def pool(trial: int, bench_seed: int = 0) -> list:
-    """The scenes Episode._test_set draws for a trial (same seed path, same draws)."""
+    """The scenes an episode of this trial is scored on (its test seed, the default sizes)."""
     _, test_seed = trial_seeds(bench_seed, "any intention", trial)
-    rng = np.random.default_rng(EpisodeSeeds.from_seed(0, test_seed).test)
-    scenes = []
-    for _ in range(DEFAULT_TEST_SCENES + DEFAULT_TEST_POOL):
-        scenes.append(sample_test_scene(rng))
-        rng.integers(2**31)  # the layout seed
-    return scenes
+    scenes = draw_test_scenes(EpisodeSeeds.from_seed(0, test_seed).test, DEFAULT_TEST_SCENES + DEFAULT_TEST_POOL)
+    return [s for s, _ in scenes]
 
 
 @pytest.mark.parametrize("name", SUITE_NAMES)

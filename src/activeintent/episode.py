@@ -39,8 +39,8 @@ from activeintent.protocol import (
     FORMAT_VERSION,
     FREE_NEW_SCENES,
     NewSceneRule,
+    draw_test_scenes,
     sample_round_scene,
-    sample_test_scene,
 )
 from activeintent.provenance import provenance
 from activeintent.records import EpisodeRecorder
@@ -252,17 +252,11 @@ class Episode:
                          stop_time=stop_time)
 
     # -- scoring -------------------------------------------------------------------------------
-    def _test_set(self) -> list[tuple[Scene, int]]:
-        """The curve's scenes first, then the rest of the pool (one draw: the first ``test_scenes``
-        do not depend on the pool's size)."""
-        rng = np.random.default_rng(self.seeds.test)
-        n = self.config.test_scenes + self.config.test_pool
-        return [(sample_test_scene(rng), int(rng.integers(2**31))) for _ in range(n)]
-
-    def _score(self, k: int, tests: list[tuple[Scene, int]], physics: bool, final: bool
-               ) -> tuple[float | None, list[TestLog]]:
+    def _score(self, k: int, tests: list[tuple[Scene, int]], final: bool) -> tuple[float | None, list[TestLog]]:
         """The learner's current answer on the test scenes (``final``: the whole pool, else the
-        curve's); success over the feasible ones. Physics runs on the curve's scenes only."""
+        curve's); success over the feasible ones. Physics (a physics env, ``final`` only) runs on
+        the curve's scenes."""
+        physics = final and self.env.name != "symbolic"
         logs = []
         for i, (scene, seed) in enumerate(tests if final else tests[:self.config.test_scenes]):
             physics_here = physics and i < self.config.test_scenes
@@ -300,7 +294,7 @@ class Episode:
         scene_rng = np.random.default_rng(self.seeds.scenes)
         layout_rng = np.random.default_rng(self.seeds.layouts)
         learner_rng = np.random.default_rng(self.seeds.learner)
-        tests = self._test_set()
+        tests = draw_test_scenes(self.seeds.test, self.config.test_scenes + self.config.test_pool)
         logs: list[RoundLog] = []
         success_at: list[float | None] = []
         test_logs: list[TestLog] = []
@@ -308,10 +302,9 @@ class Episode:
         done_at = None
         error = None
         after_new_scene = False
-        physics = self.env.name != "symbolic"
         try:
             if cfg.curve or cfg.budget == 0 or not self.learner.asks:
-                rate, test_logs = self._score(0, tests, physics and cfg.budget == 0, final=cfg.budget == 0)
+                rate, test_logs = self._score(0, tests, final=cfg.budget == 0)
             else:  # slow learners (model calls) are scored at k = K only
                 rate = None
             success_at.append(rate)
@@ -328,8 +321,7 @@ class Episode:
                 if log.done and done_at is None:
                     done_at = signals
                 if log.counted and (cfg.curve or signals == cfg.budget):
-                    last = signals == cfg.budget
-                    rate, test_logs = self._score(signals, tests, physics and last, final=last)
+                    rate, test_logs = self._score(signals, tests, final=signals == cfg.budget)
                     success_at.append(rate)
                 elif log.counted:
                     success_at.append(None)
@@ -339,7 +331,7 @@ class Episode:
                 # No more signals come (zero-signal baseline, or the learner finished): its answer
                 # stands for the rest of the budget, and is scored on the whole pool for k = K.
                 success_at += [rate] * (cfg.budget - len(success_at))
-                rate, test_logs = self._score(signals, tests, physics, final=True)
+                rate, test_logs = self._score(signals, tests, final=True)
                 success_at.append(rate)
         except ModelError as err:
             error = f"model error after {signals} signals: {err}"

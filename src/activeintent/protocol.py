@@ -47,6 +47,13 @@ def sample_test_scene(rng: np.random.Generator) -> Scene:
     return sample_scene(rng, n_blocks=n_blocks, n_bowls=n_bowls, matching=None)
 
 
+def draw_test_scenes(seed: int, n: int) -> list[tuple[Scene, int]]:
+    """An episode's ``n`` test scenes with their layout seeds, drawn in order from ``seed``: the
+    curve's scenes come first and do not depend on the pool's size."""
+    rng = np.random.default_rng(seed)
+    return [(sample_test_scene(rng), int(rng.integers(2**31))) for _ in range(n)]
+
+
 def sample_round_scene(rng: np.random.Generator) -> Scene:
     """A query scene when the learner designs none: two or three blocks and two bowls whose
     colours match blocks' where possible — scenes that can show most intentions, chosen

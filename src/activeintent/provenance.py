@@ -35,6 +35,7 @@ def _git(*args: str) -> str | None:
     return out.stdout.strip()
 
 
+@lru_cache(maxsize=1)
 def cpu_model() -> str:
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
