@@ -44,9 +44,11 @@ from activeintent.protocol import (
 )
 from activeintent.provenance import provenance
 from activeintent.records import EpisodeRecorder
-from activeintent.signals import Answer
+from activeintent.signals import Answer, answer_kind_from_dump
 from activeintent.world import Scene, Skill, WorldState, apply_plan, describe_plan, layout
 from activeintent.world.trajectory import Trajectory
+
+__all__ = ["Episode", "EpisodeConfig", "EpisodeResult", "answer_kind_from_dump"]
 
 
 class EpisodeConfig(BaseModel):
@@ -156,6 +158,7 @@ class EpisodeResult(BaseModel):
     time_split: dict[str, float] = Field(default_factory=dict)
     tests: list[TestLog] = Field(default_factory=list)
     learner_stats: dict = Field(default_factory=dict)
+    diagnostics: dict = Field(default_factory=dict)  # the learner's, per answer (bits, kinds, top z)
     user: dict = Field(default_factory=dict)
     error: str | None = None
     config: dict = Field(default_factory=dict)
@@ -371,6 +374,7 @@ class Episode:
             time_split=split,
             tests=test_logs,
             learner_stats=self.learner.stats(),
+            diagnostics=self.learner.diagnostics(),
             user=getattr(self.user, "parameters", lambda: {})(),
             error=error,
             config={"episode": cfg.model_dump(), **self.extra_config},
@@ -382,12 +386,14 @@ class Episode:
     def _round(self, index: int, scene_rng, layout_rng, learner_rng, after_new_scene: bool) -> RoundLog:
         t0 = dict(self.clock.split)
         scene, source = None, "learner"
-        if after_new_scene:
+        if after_new_scene and not self.learner.redesigns_after_new_scene:
             source = "sampled (the user asked for a new scene)"
         else:
             scene = self.clock.timed("learner_s", self.learner.design_scene, learner_rng)
             if scene is None:
                 source = "sampled (the learner designs no scenes, or its choice was unusable)"
+            elif after_new_scene:
+                source = "learner (after a new-scene answer)"
         if scene is None:
             scene = sample_round_scene(scene_rng)
         layout_seed = int(layout_rng.integers(2**31))
@@ -417,14 +423,3 @@ class Episode:
             calls=self.learner.drain_transcript() + self._executor_calls(),
             timing={k: round(v - t0[k], 4) for k, v in self.clock.split.items()},
         )
-
-
-def answer_kind_from_dump(d: dict) -> str:
-    """A short label of an answer (as stored), for counts and tables."""
-    if d.get("new_scene"):
-        return "new_scene"
-    if "choice" in d:
-        return str(d["choice"])
-    if "stop_time" in d:
-        return "no_stop" if d["stop_time"] is None else "stop"
-    return str(d.get("signal"))

@@ -20,6 +20,9 @@ from activeintent.protocol import FORMAT_VERSION
 
 NOT_VERIFIED = "NOT-VERIFIED.md"  # a folder's own word on why it cannot be re-run
 NOT_COMPARED = frozenset({"wall_s", "time_split", "provenance", "traceback"})
+# Record fields added after format 3 began: compared when the recorded episode has them (an
+# older record cannot differ in a field it never had; every field it has is compared).
+ADDED_IN_FORMAT_3 = frozenset({"diagnostics"})
 
 
 class StaleFolder(ValueError):
@@ -34,7 +37,7 @@ def differences(recorded: dict, again: dict, prefix: str = "") -> dict[str, tupl
     """Fields whose values differ, nested keys joined by '.' (``NOT_COMPARED`` left out)."""
     out: dict[str, tuple] = {}
     for key in sorted(set(recorded) | set(again)):
-        if not prefix and key in NOT_COMPARED:
+        if not prefix and (key in NOT_COMPARED or (key in ADDED_IN_FORMAT_3 and key not in recorded)):
             continue
         a, b = recorded.get(key), again.get(key)
         if isinstance(a, dict) and isinstance(b, dict):

@@ -51,12 +51,18 @@ class Learner(ABC):
     asks: bool = True  # False for the zero-signal baseline: it never shows a query
     may_finish: bool = False  # may its "done" end an episode outside the benchmark?
     retriever: str | None = None  # which retriever produced r (stop methods), for the logs
+    # Does it design the scene that follows a "new scene" answer? (else the episode samples one)
+    redesigns_after_new_scene: bool = False
 
     def execution_failed(self, goal: str, reason: str) -> None:  # noqa: B027 - optional hook
         """The executor could not turn goal y into motion; the next estimate should be simpler."""
 
     def stats(self) -> dict:
         """Method-specific figures for the results."""
+        return {}
+
+    def diagnostics(self) -> dict:
+        """Why it learned as it did, per answer (for the report's diagnostics section)."""
         return {}
 
     def drain_transcript(self) -> list[dict]:

@@ -110,14 +110,16 @@ METHODS.register("random-query", lambda: Method("stop", False, _bayes("stop", "r
 METHODS.register("random-query-preference", lambda: Method("preference", False, _bayes("preference", "random"),
                  "baseline: bayes-preference's belief update with random A/B queries", "baseline"))
 
-def _lang(signal: str) -> Method:  # the builder lives in learners/lang
+def _lang(signal: str, prefix: str = "lang") -> Method:  # the builder lives in learners/lang
     from activeintent.learners.lang.learner import lang_method
 
-    return lang_method(signal)
+    return lang_method(signal, prefix)
 
 
 METHODS.register("lang-stop", lambda: _lang("stop"))
 METHODS.register("lang-preference", lambda: _lang("preference"))
+METHODS.register("decide-stop", lambda: _lang("stop", "decide"))
+METHODS.register("decide-preference", lambda: _lang("preference", "decide"))
 
 PAPER_METHODS = ("preference", "mllm", "mllm-llm")
 BASELINES = ("zero-signal", "random-query", "random-query-preference")

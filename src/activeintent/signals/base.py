@@ -33,6 +33,17 @@ class Answer(BaseModel):
         return str(self.model_dump(exclude={"signal", "new_scene"}))
 
 
+def answer_kind_from_dump(d: dict) -> str:
+    """A short label of an answer (as stored): new_scene, stop, no_stop, the choice…"""
+    if d.get("new_scene"):
+        return "new_scene"
+    if "choice" in d:
+        return str(d["choice"])
+    if "stop_time" in d:
+        return "no_stop" if d["stop_time"] is None else "stop"
+    return str(d.get("signal"))
+
+
 class Judge(Protocol):
     """Judges outcomes under n intentions at once: n = 1 for a simulated user (its hidden
     intention), n = |H| for a Bayesian learner (its hypotheses)."""

@@ -46,8 +46,22 @@ def table_position_name(xy: tuple[float, float] | np.ndarray) -> str:
     return names[row][col]
 
 
+_MEMO: dict[tuple, Relations] = {}  # planners and judges ask about the same states again and again
+
+
 def relations(state: WorldState) -> Relations:
-    """Compute relations from geometry (centres; blocks are 4 cm cubes)."""
+    """Compute relations from geometry (centres; blocks are 4 cm cubes). Memoised on the exact
+    positions (in order): the result is shared, so callers must not change it."""
+    key = tuple(state.positions.items())
+    got = _MEMO.get(key)
+    if got is None:
+        if len(_MEMO) > 50000:
+            _MEMO.clear()
+        got = _MEMO[key] = _relations(state)
+    return got
+
+
+def _relations(state: WorldState) -> Relations:
     blocks, bowls = state.blocks, state.bowls
     on: list[tuple[str, str]] = []
     inside: list[tuple[str, str]] = []

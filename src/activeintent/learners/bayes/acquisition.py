@@ -5,6 +5,12 @@ P(h | z, q) for every hypothesis z; with the answer "new scene" appended (likely
 the scene cannot show z, up to the learner's assumed error rate ε_ns)::
 
     EIG(q) = H[Σ_z w_z P(h | z, q)] − Σ_z w_z H[P(h | z, q)]
+
+By the chain rule EIG = I(f; z) + I(h; z | f), f = "the answer is new scene": the first part is
+what the scene's feasibility tells, the second what the shown trajectories tell. ``gain="shown"``
+keeps only the second, P(f = 0) · EIG over the belief restricted to the z the scene can show.
+``gain="decision"`` scores the information about the decision class of z instead
+(decision.py: z grouped by which plans satisfy them on scenes the robot will meet).
 """
 
 from __future__ import annotations
@@ -17,8 +23,11 @@ from pydantic import BaseModel
 
 from activeintent import ranking
 from activeintent.learners.bayes.candidates import Outcome
+from activeintent.learners.bayes.decision import class_information
 from activeintent.signals import Judge, Signal
 from activeintent.world import describe_plan
+
+GAINS = ("goal", "shown", "decision")
 
 
 def _entropy(p: np.ndarray) -> np.ndarray:
@@ -84,6 +93,8 @@ def select_query(
     choose: str = "eig",
     max_queries: int = 700,
     cap: int = 4000,
+    gain: str = "goal",
+    classes: np.ndarray | None = None,
 ) -> Query | None:
     """The query (``signal.shows`` distinct outcomes) with the largest EIG; ``choose="random"``
     picks uniformly among the candidates instead (same planner, same belief update). EIG is
@@ -97,16 +108,31 @@ def select_query(
     if choose == "random":
         pick = combos[int(rng.integers(len(combos)))]
         return Query([outs[i] for i in pick], float("nan"))
+    if gain not in GAINS:
+        raise ValueError(f"unknown gain {gain!r}; valid gains: {', '.join(GAINS)}")
+    if gain == "decision" and classes is None:
+        raise ValueError("gain='decision' needs the hypotheses' decision classes")
     if len(weights) > cap:
         idx = particles(weights, cap=cap)
         judge, feasible = JudgeView(judge, idx), feasible[idx]  # type: ignore[assignment]
         weights = weights[idx] / weights[idx].sum()
+        if classes is not None:
+            classes = np.unique(classes[idx], return_inverse=True)[1].reshape(-1)
+    if gain == "shown":
+        p_shown = (1 - new_scene_error) * float(weights @ feasible) + new_scene_error * float(weights @ ~feasible)
+        w_shown = weights * np.where(feasible, 1 - new_scene_error, new_scene_error)
+        w_shown = w_shown / w_shown.sum()
     gains = np.empty(len(combos))
     for n, combo in enumerate(combos):
         probs = signal.predictive([outs[i].traj for i in combo], judge, model)
+        if gain == "shown":
+            g = p_shown * eig(w_shown, probs)
+        elif gain == "decision":
+            g = class_information(weights, with_new_scene(probs, feasible, new_scene_error), classes)  # type: ignore[arg-type]
+        else:
+            g = eig(weights, with_new_scene(probs, feasible, new_scene_error))
         # Among (near-)equal gains prefer short plans: they are quicker to watch.
-        gains[n] = eig(weights, with_new_scene(probs, feasible, new_scene_error)) - 1e-4 * sum(
-            len(outs[i].plan) for i in combo)
+        gains[n] = g - 1e-4 * sum(len(outs[i].plan) for i in combo)
     order = ranking.order(gains)
     best = combos[order[0]]
     alternatives = [

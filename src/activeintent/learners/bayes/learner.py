@@ -16,7 +16,10 @@ description of the most probable hypothesis.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 from pydantic import BaseModel, Field
@@ -26,11 +29,12 @@ from activeintent.learners.base import Estimate, Learner, RoundRecord
 from activeintent.learners.bayes.acquisition import Query, select_query
 from activeintent.learners.bayes.belief import Belief, Prior
 from activeintent.learners.bayes.candidates import candidate_plans, predict
+from activeintent.learners.bayes.decision import decision_classes, deployment_states
 from activeintent.learners.bayes.facts import facts
 from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space, random_scene
 from activeintent.learners.bayes.judge import HypothesisJudge
 from activeintent.llm.base import ChatModel, ModelError
-from activeintent.signals import Answer, Signal, get_signal
+from activeintent.signals import Answer, Signal, answer_kind_from_dump, get_signal
 from activeintent.world import (
     Scene,
     WorldState,
@@ -42,12 +46,32 @@ from activeintent.world import (
 from activeintent.world.trajectory import Trajectory
 
 
+def kl_bits(after: np.ndarray, before: np.ndarray) -> float:
+    """KL(after ‖ before) in bits: the information one answer gave the belief."""
+    m = after > 0
+    return float((after[m] * np.log2(after[m] / np.clip(before[m], 1e-300, None))).sum())
+
+
+def answer_kind(answer: Answer) -> str:
+    """new_scene, stop, no_stop, a, b, none…: the label the report counts."""
+    return answer_kind_from_dump(answer.model_dump(mode="json"))
+
+
 class BayesConfig(BaseModel):
     """Settings of the Bayesian learners (none is tuned to particular intentions)."""
 
     prior: Prior = Field("length", description="length: P(z) ∝ 2^-L(z); uniform: the ablation")
     choose: str = Field("eig", description="eig: largest expected information gain; random: the baseline")
     n_scenes: int = Field(4, ge=1, description="candidate scenes scored per design_scene")
+    scenes: Literal["random", "belief"] = Field(
+        "random", description="random: n_scenes random scenes; belief: the n_scenes of scene_candidates random "
+        "ones that the belief most expects to show its goals, also after a 'new scene' answer")
+    scene_candidates: int = Field(48, ge=1, description="scenes drawn per design_scene when scenes = belief")
+    gain: Literal["goal", "shown", "decision"] = Field(
+        "goal", description="goal: EIG about z, the 'new scene' answer included; shown: only what the "
+        "answers to the shown trajectories tell (the feasibility part of the EIG left out); decision: "
+        "information about which plans to run on scenes of the public test distribution (decision.py)")
+    deploy_scenes: int = Field(8, ge=1, description="gain = decision: the learner's own scenes of the test distribution")
     top_k: int = Field(16, ge=1, description="plans come from this many most probable hypotheses")
     explore: int = Field(6, ge=0, description="... plus this many random other hypotheses")
     max_plans: int = Field(36, ge=2, description="candidate plans per scene")
@@ -103,8 +127,16 @@ class BayesLearner(Learner):
         self.proposal_calls = 0
         self.proposal_errors: list[str] = []
         self.log: list[dict] = []
+        self.answer_log: list[dict] = []  # diagnostics(): one entry per answer
         self.prior_entropy = self.belief.entropy_bits()
         self._drained = 0
+        self._classes: tuple[tuple[int, int], np.ndarray] | None = None
+        self.deploy = (deployment_states(int(self.rng.integers(2**31)), self.config.deploy_scenes)
+                       if self.config.gain == "decision" else [])
+
+    @property
+    def redesigns_after_new_scene(self) -> bool:  # type: ignore[override]
+        return self.config.scenes == "belief"
 
     # ---- belief views ----
 
@@ -135,6 +167,9 @@ class BayesLearner(Learner):
             "proposed_kept": sum(len(e.get("proposed", [])) for e in self.log),
         }
 
+    def diagnostics(self) -> dict:
+        return {"answers": list(self.answer_log)}
+
     def drain_transcript(self) -> list[dict]:
         out = [dict(entry, template="belief") for entry in self.log[self._drained:]]
         self._drained = len(self.log)
@@ -149,14 +184,42 @@ class BayesLearner(Learner):
                                prefixes=self.sig.shows > 1, limit=c.max_plans, feasible=feasible)
         feasible = self.judge.feasible(tuple(state.positions))  # the planner may have found some z infeasible
         return select_query(self.sig, self.model, self.judge, self.weights, feasible, outs,
-                            c.new_scene_error, self.rng, choose=c.choose)
+                            c.new_scene_error, self.rng, choose=c.choose, gain=c.gain,
+                            classes=self.decision_classes() if c.gain == "decision" else None)
+
+    def decision_classes(self) -> np.ndarray:
+        """z grouped by the plans that satisfy them on the learner's deployment scenes (once per
+        belief: the answers so far and the size of H key it)."""
+        key = (len(self.observations), len(self.hyps))
+        if self._classes is None or self._classes[0] != key:
+            rng = np.random.default_rng(list(key))  # not the learner's stream: a cache must not move it
+            self._classes = (key, decision_classes(self.hyps, self.weights, self.judge, self.deploy, rng,
+                                                   top_k=self.config.final_top_k, limit=self.config.max_plans))
+        return self._classes[1]
+
+    def shown_mass(self, scene: Scene) -> float:
+        """Σ_z w_z 1[z can be shown in ``scene``]: the belief's chance that the user answers
+        about the trajectories rather than "new scene"."""
+        return float(self.weights @ self.judge.feasible(tuple(scene.objects)))
+
+    def _scene_candidates(self) -> Iterator[Scene]:
+        """Lazily: with random scenes each draw is followed by its layout's, in the learner's stream."""
+        c = self.config
+        if c.choose == "random" or c.scenes == "random":
+            for _ in range(1 if c.choose == "random" else c.n_scenes):
+                yield random_scene(self.rng)
+            return
+        drawn = [random_scene(self.rng) for _ in range(c.scene_candidates)]
+        mass = np.array([self.shown_mass(s) for s in drawn])
+        keep = ranking.order(mass)[:c.n_scenes]  # most likely to be shown; ties to the first drawn
+        yield from (drawn[i] for i in sorted(keep))
 
     def design_scene(self, rng: np.random.Generator) -> Scene | None:
         """The candidate scene (3–5 objects, from the learner's own rng) whose best query has
-        the largest information gain."""
+        the largest information gain (``scenes = belief``: among those the belief most expects
+        to be able to show its goals)."""
         best: tuple[Scene, Query] | None = None
-        for _ in range(1 if self.config.choose == "random" else self.config.n_scenes):
-            scene = random_scene(self.rng)
+        for scene in self._scene_candidates():
             q = self._select(WorldState(positions=layout(scene, int(self.rng.integers(2**31)))))
             if q is not None and (best is None or ranking.greater(q.gain, best[1].gain)):
                 best = (scene, q)
@@ -204,7 +267,17 @@ class BayesLearner(Learner):
                  [f"step {s.index + 1}: {describe_skill(s.skill)}" for t in trajectories for s in t.steps])
         obs = Observation(record.scene, answer, list(trajectories), texts)
         lik = self._likelihood(obs, self.hyps, self.judge)
+        before = self.weights
+        shown = self.shown_mass(record.scene)
         evidence = self.belief.update(lik)
+        gain = record.estimate.why.get("eig_nats") if record.estimate is not None else None
+        self.answer_log.append({
+            "answer": answer_kind(answer),
+            "kl_bits": round(kl_bits(self.weights, before), 4),  # what this answer taught: KL(w' ‖ w)
+            "gain_bits": None if gain is None else round(gain / math.log(2), 4),  # what the query promised
+            "shown_mass": round(shown, 4),  # the belief's P(the scene can show z) before the answer
+            "top": [(h.name, round(p, 4)) for h, p in self.top(3)],
+        })
         self.observations.append(obs)
         surprised = not answer.new_scene and evidence < self.config.surprise * float(lik.max())
         proposed: list[str] = []

@@ -181,11 +181,26 @@ class LangLearner(BayesLearner):
         return out
 
 
-def lang_method(signal: str):
-    """The registry entry of ``lang-<signal>`` (built from a LearnerContext like ``bayes``)."""
+# ``decide-<signal>``: questions about what the robot will do (issue "Questions worth a person's
+# answer"): scenes the belief expects to show its goals, queries scored by what their answer
+# tells about the decision (examples/decide_ablation.py switches each part off).
+DECIDE = {"scenes": "belief", "gain": "decision"}
+
+
+def lang_method(signal: str, prefix: str = "lang"):
+    """The registry entry of ``lang-<signal>`` or ``decide-<signal>`` (built from a
+    LearnerContext like ``bayes``)."""
     from activeintent.learners.registry import LearnerContext, Method
 
-    def build(ctx: LearnerContext) -> LangLearner:
-        return LangLearner(signal, rng=ctx.seed, llm=ctx.llm, config=LangConfig(prior=ctx.prior))  # type: ignore[arg-type]
+    settings = DECIDE if prefix == "decide" else {}
 
+    def build(ctx: LearnerContext) -> LangLearner:
+        learner = LangLearner(signal, rng=ctx.seed, llm=ctx.llm,
+                              config=LangConfig(prior=ctx.prior, **settings))  # type: ignore[arg-type]
+        learner.name = f"{prefix}-{signal}"
+        return learner
+
+    if prefix == "decide":
+        return Method(signal, False, build, f"ours: the goal-language belief, scenes designed from it, {signal} "
+                      "queries by information about the decision")
     return Method(signal, False, build, f"ours: growing belief over the goal language, {signal} queries by EIG")

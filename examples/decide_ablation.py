@@ -1,0 +1,37 @@
+"""Ablations of ``decide-<signal>``: each part of it switched back to ``lang-<signal>``'s.
+
+    bin/activeintent bench --plugin examples/decide_ablation.py \\
+        --methods decide-stop,decide-random-scenes-stop,decide-goal-gain-stop,decide-shown-gain-stop,lang-stop ...
+
+- ``decide-random-scenes-<signal>``: random candidate scenes, and the protocol's sampler after a
+  "new scene" answer (lang's), with the decision gain;
+- ``decide-goal-gain-<signal>``: scenes from the belief, queries by EIG about z (lang's gain);
+- ``decide-shown-gain-<signal>``: scenes from the belief, EIG about z without what the scene's
+  feasibility tells.
+"""
+
+from activeintent.learners.lang.learner import DECIDE, LangConfig, LangLearner
+from activeintent.learners.registry import METHODS, LearnerContext, Method
+
+ABLATIONS = {
+    "random-scenes": {"scenes": "random"},
+    "goal-gain": {"gain": "goal"},
+    "shown-gain": {"gain": "shown"},
+}
+
+
+def _ablation(part: str, signal: str) -> Method:
+    name = f"decide-{part}-{signal}"
+
+    def build(ctx: LearnerContext) -> LangLearner:
+        config = LangConfig(prior=ctx.prior, **{**DECIDE, **ABLATIONS[part]})
+        learner = LangLearner(signal, rng=ctx.seed, llm=ctx.llm, config=config)
+        learner.name = name
+        return learner
+
+    return Method(signal, False, build, f"ablation: decide-{signal} with {ABLATIONS[part]}")
+
+
+for _part in ABLATIONS:
+    for _signal in ("stop", "preference"):
+        METHODS.register(f"decide-{_part}-{_signal}", lambda p=_part, s=_signal: _ablation(p, s))
