@@ -76,7 +76,8 @@ def test_every_truth_goal_parses_is_short_showable_and_not_trivial():
         feasible, already = tg.measure(goal)
         assert feasible >= tg.MIN_FEASIBLE, (g["name"], feasible)
         assert already < tg.MAX_ALREADY, (g["name"], already)
-        assert (round(feasible, 4), round(already, 4)) == (g["feasible"], g["already"]), g["name"]
+        assert (round(feasible, 4), round(already, 4)) == (g["feasible"], g["already"]), (
+            f"{g['name']}: the planner or the scenes changed; redraw with `{tg.REDRAW}`")
         assert not (goal.stays and tg.stays_is_vacuous(goal)), g["name"]
     # filter 3 (enough scenes in every default trial's pool) is tests/test_protocol.py's check
 
