@@ -1,6 +1,8 @@
 """Benchmark suites of hidden intentions: ``paper`` (the paper's four), ``library`` (the other
 built-in intentions), ``heldout`` (written blind, before any learner change, in
-``bench/heldout.py``; reported separately) and ``dev`` (``bench/dev.py``: for tuning learners).
+``bench/heldout.py``; reported separately), ``dev`` (``bench/dev.py``: for tuning learners) and
+``truth-goals`` (``truth-00`` … ``truth-49``: 50 goals of the goal language drawn at random and
+committed as data, ``bench/truth_goals.json``; learning efficiency apart from coverage).
 Names of every suite resolve everywhere an intention name is accepted.
 """
 
@@ -15,7 +17,7 @@ from activeintent.intentions.registry import (
     resolve_intention,
 )
 
-SUITE_NAMES = ("paper", "library", "heldout", "dev")
+SUITE_NAMES = ("paper", "library", "heldout", "dev", "truth-goals")
 
 
 def _heldout() -> dict[str, Intention]:
@@ -30,6 +32,18 @@ def _dev() -> dict[str, Intention]:
     return {it.name: it for it in dev_intentions()}
 
 
+def _truth() -> dict[str, Intention]:
+    from activeintent.bench.truth_goals import truth_intentions
+
+    return {it.name: it for it in truth_intentions()}
+
+
+def _truth_names() -> list[str]:
+    from activeintent.bench.truth_goals import truth_names
+
+    return truth_names()
+
+
 def suite(name: str) -> list[str]:
     """Intention names of a suite."""
     if name == "paper":
@@ -40,6 +54,8 @@ def suite(name: str) -> list[str]:
         return list(_heldout())
     if name == "dev":
         return list(_dev())
+    if name == "truth-goals":
+        return _truth_names()
     raise ValueError(f"Unknown suite {name!r}; valid suites: {', '.join(SUITE_NAMES)}.")
 
 
@@ -51,6 +67,8 @@ def suite_of(intention: str) -> str:
         return "paper"
     if intention in INTENTION_NAMES:
         return "library"
+    if intention.startswith("truth-") and intention in _truth_names():
+        return "truth-goals"
     return "dev" if intention in _dev() else "heldout"
 
 
@@ -63,10 +81,14 @@ def resolve(name: str | None, intention_file: str | None = None) -> Intention:
         held = _heldout()
         if name in held:
             return held[name]
+        truth = _truth()
+        if name in truth:
+            return truth[name]
         try:
             return get_intention(name)
         except IntentionError as err:
             raise IntentionError(
-                f"{err} Held-out intentions: {', '.join(held)}. Dev intentions: {', '.join(dev)}."
+                f"{err} Held-out intentions: {', '.join(held)}. Dev intentions: {', '.join(dev)}. "
+                f"Truth-goal intentions: {_truth_names()[0]} … {_truth_names()[-1]}."
             ) from None
     return resolve_intention(name, intention_file)

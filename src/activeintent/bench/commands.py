@@ -40,7 +40,7 @@ def _apply_preset(preset: str, methods: str, intentions: str, budget: int) -> tu
 
 def bench(
     methods: Annotated[str, typer.Option("--methods", help="Comma-separated methods (default: bayes-preference, bayes-stop and the baselines)")] = "",
-    suite: Annotated[str, typer.Option("--suite", help="Comma-separated suites: paper, library, heldout, dev")] = "paper",
+    suite: Annotated[str, typer.Option("--suite", help="Comma-separated suites: paper, library, heldout, dev, truth-goals")] = "paper",
     intentions: Annotated[str, typer.Option("--intentions", help="Comma-separated intentions (instead of --suite)")] = "",
     intention_file: Annotated[list[str] | None, typer.Option("--intention-file", help="Add your own: path.py:NAME (repeatable)")] = None,
     plugin: opt.Plugin = None,
