@@ -143,6 +143,10 @@ class Hypothesis(Intention):
                 return False
         return True
 
+    def can_show(self, objects: tuple[str, ...]) -> bool:
+        """Could a scene of these objects show z? (the scene designer asks this of few z at a time)"""
+        return self.feasible(Scene(objects=list(objects)))
+
     def sample_scene(self, rng: np.random.Generator) -> Scene:
         for _ in range(500):
             scene = random_scene(rng)

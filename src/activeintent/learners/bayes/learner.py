@@ -26,7 +26,7 @@ from pydantic import BaseModel, Field
 
 from activeintent import ranking
 from activeintent.learners.base import Estimate, Learner, RoundRecord
-from activeintent.learners.bayes.acquisition import Query, select_query
+from activeintent.learners.bayes.acquisition import Query, particles, select_query
 from activeintent.learners.bayes.belief import Belief, Prior
 from activeintent.learners.bayes.candidates import candidate_plans, predict
 from activeintent.learners.bayes.decision import decision_classes, deployment_states
@@ -66,7 +66,7 @@ class BayesConfig(BaseModel):
     scenes: Literal["random", "belief"] = Field(
         "random", description="random: n_scenes random scenes; belief: the n_scenes of scene_candidates random "
         "ones that the belief most expects to show its goals, also after a 'new scene' answer")
-    scene_candidates: int = Field(48, ge=1, description="scenes drawn per design_scene when scenes = belief")
+    scene_candidates: int = Field(16, ge=1, description="scenes drawn per design_scene when scenes = belief")
     gain: Literal["goal", "shown", "decision"] = Field(
         "goal", description="goal: EIG about z, the 'new scene' answer included; shown: only what the "
         "answers to the shown trajectories tell (the feasibility part of the EIG left out); decision: "
@@ -203,14 +203,27 @@ class BayesLearner(Learner):
         return float(self.weights @ self.judge.feasible(tuple(scene.objects)))
 
     def _scene_candidates(self) -> Iterator[Scene]:
-        """Lazily: with random scenes each draw is followed by its layout's, in the learner's stream."""
+        """Lazily: with random scenes each draw is followed by its layout's, in the learner's stream.
+        ``scenes = belief``: each candidate is a random scene that can show a z drawn from the
+        belief (up to 20 draws); kept are the n_scenes that can show the most of the likely z
+        (those holding 99 % of the belief, at most 64)."""
         c = self.config
         if c.choose == "random" or c.scenes == "random":
             for _ in range(1 if c.choose == "random" else c.n_scenes):
                 yield random_scene(self.rng)
             return
-        drawn = [random_scene(self.rng) for _ in range(c.scene_candidates)]
-        mass = np.array([self.shown_mass(s) for s in drawn])
+        likely = particles(self.weights, mass=0.99, cap=64)
+        w = self.weights[likely] / self.weights[likely].sum()
+        drawn = []
+        for _ in range(c.scene_candidates):
+            z = self.hyps[likely[int(self.rng.choice(len(likely), p=w))]]
+            for _ in range(20):
+                scene = random_scene(self.rng)
+                if z.can_show(tuple(scene.objects)):
+                    break
+            drawn.append(scene)
+        mass = np.array([sum(w[j] for j, i in enumerate(likely) if self.hyps[i].can_show(tuple(s.objects)))
+                         for s in drawn])
         keep = ranking.order(mass)[:c.n_scenes]  # most likely to be shown; ties to the first drawn
         yield from (drawn[i] for i in sorted(keep))
 

@@ -107,6 +107,9 @@ class LangHypothesis(Hypothesis):
     def feasible(self, scene: Scene) -> bool:
         return bool(self.space.feasible(tuple(scene.objects))[self.index])
 
+    def can_show(self, objects: tuple[str, ...]) -> bool:  # one goal's static check, not the space's
+        return self.goal.possible(objects) and self.index not in self.space.failed.get(objects, ())
+
     def plans(self, state: WorldState, variants: int | None = None) -> list[list[Skill]]:
         return self.space.plans(self.index, state, variants)
 
