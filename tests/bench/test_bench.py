@@ -72,6 +72,20 @@ def test_report_intervals_are_wilson_intervals_of_the_episodes(tmp_path):
     assert checked == 6
 
 
+def test_the_report_prints_what_the_answers_told_the_learner(tmp_path):
+    def rows(*kinds_bits):
+        return {"answers": [{"answer": k, "kl_bits": b, "gain_bits": 1.0, "shown_mass": 0.5, "top": []}
+                            for k, b in kinds_bits]}
+
+    records = [{"method": "bayes-stop", "intention": "stack", "trial": t, "success": 0.5, "success_at": [0.0, 0.5],
+                "signals_used": 2, "answers": {}, "diagnostics": d}
+               for t, d in enumerate([rows(("stop", 1.5), ("new_scene", 0.3)), rows(("stop", 0.9), ("no_stop", 0.5))])]
+    text = write_report(records, ["bayes-stop"], ["stack"], tmp_path, {"env": "symbolic", "budget": 2}).read_text()
+    (row,) = [line for line in text.splitlines() if line.startswith("| paper | bayes-stop |")]
+    assert "| 4 (2) |" in row and "new_scene 25%, no_stop 25%, stop 50%" in row
+    assert "| 0.80 |" in row and "stop 1.20" in row and "new_scene 0.30" in row and "| 0.50 |" in row
+
+
 def test_trial_seeds():
     assert trial_seeds(5, "stack", 0)[1] == trial_seeds(5, "color-match", 0)[1]  # test scenes: per trial only
     assert trial_seeds(5, "stack", 0)[0] != trial_seeds(5, "color-match", 0)[0]

@@ -47,8 +47,10 @@ def wilson(successes: float, n: int, z: float = 1.96) -> tuple[float, float]:
     return (max(0.0, centre - half), min(1.0, centre + half))
 
 
-# EIG learners and the baselines that share their belief but ask at random.
-PAIRED = (("bayes-stop", "random-query"), ("bayes-preference", "random-query-preference"))
+# EIG learners and the baselines that share their belief but ask at random; the decision-aware
+# learners and the language learners they extend.
+PAIRED = (("bayes-stop", "random-query"), ("bayes-preference", "random-query-preference"),
+          ("decide-stop", "lang-stop"), ("decide-preference", "lang-preference"))
 
 
 def auc(curve: list[float | None]) -> float | None:
@@ -183,16 +185,63 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
         lines.append(f"| {m} | " + " | ".join(cells) + " |")
     pairs = [d for a, b in PAIRED if a in methods and b in methods and (d := paired_difference(records, a, b))]
     if pairs:
-        lines += ["", "## EIG against random questions (paired)", "",
-                  "Area under success@k (mean over k = 0..K) of each episode, minus that of the random-question "
-                  "baseline on the same intention and trial; mean [95 % interval], n = pairs.", "",
+        lines += ["", "## Paired differences (EIG against random questions; decide against lang)", "",
+                  "Area under success@k (mean over k = 0..K) of each episode, minus that of the other method "
+                  "on the same intention and trial; mean [95 % interval], n = pairs.", "",
                   "| method − baseline | difference in area | wins / ties / losses |", "|---|---|---|"]
         lines += [f"| {d['a']} − {d['b']} | {d['mean']:+.3f} [{d['lo']:+.3f}, {d['hi']:+.3f}] (n={d['n']}) | "
                   f"{d['wins']} / {d['ties']} / {d['losses']} |" for d in pairs]
+    lines += diagnostics_section(records, methods)
     lines += ["", "![success vs signals](success_vs_signals.png)", ""]
     path = out / "report.md"
     path.write_text("\n".join(lines))
     return path
+
+
+def answer_diagnostics(records: list[dict]) -> dict | None:
+    """Pooled over episodes: answers by kind, bits each answer gave the belief (KL of posterior
+    to prior, as the learner computed it), bits its query promised, the belief's P(shown)."""
+    rows = [a for r in records for a in (r.get("diagnostics") or {}).get("answers", [])]
+    if not rows:
+        return None
+    kinds: dict[str, list[dict]] = defaultdict(list)
+    for a in rows:
+        kinds[a["answer"]].append(a)
+    promised = [a["gain_bits"] for a in rows if a.get("gain_bits") is not None]
+    return {
+        "n": len(rows),
+        "episodes": sum(bool((r.get("diagnostics") or {}).get("answers")) for r in records),
+        "share": {k: len(v) / len(rows) for k, v in sorted(kinds.items())},
+        "bits": float(np.mean([a["kl_bits"] for a in rows])),
+        "bits_by_kind": {k: float(np.mean([a["kl_bits"] for a in v])) for k, v in sorted(kinds.items())},
+        "promised": float(np.mean(promised)) if promised else None,
+        "shown_mass": float(np.mean([a["shown_mass"] for a in rows])),
+    }
+
+
+def diagnostics_section(records: list[dict], methods: list[str]) -> list[str]:
+    """Why one learner beats another: what its answers were and what they told it, per suite."""
+    lines: list[str] = []
+    suites = sorted({suite_of(r["intention"]) for r in records})
+    for suite in suites:
+        for m in methods:
+            d = answer_diagnostics([r for r in records if r["method"] == m and _ok(r) and suite_of(r["intention"]) == suite])
+            if d is None:
+                continue
+            if not lines:
+                lines += ["", "## What the answers told the learner (diagnostics)", "",
+                          "Pooled over the episodes of a suite. bits/answer: KL(posterior ‖ prior) of one "
+                          "answer, in bits (the learner's own belief and answer model); promised: the gain the "
+                          "query was chosen for (EIG or decision information, bits); P(shown): the belief's "
+                          "chance, before the answer, that the scene could show its goals.", "",
+                          "| suite | method | answers (episodes) | answers by kind | bits/answer | bits by kind "
+                          "| promised | P(shown) |", "|---|---|---|---|---|---|---|---|"]
+            share = ", ".join(f"{k} {v:.0%}" for k, v in d["share"].items())
+            by_kind = ", ".join(f"{k} {v:.2f}" for k, v in d["bits_by_kind"].items())
+            promised = "–" if d["promised"] is None else f"{d['promised']:.2f}"
+            lines.append(f"| {suite} | {m} | {d['n']} ({d['episodes']}) | {share} | {d['bits']:.2f} | {by_kind} | "
+                         f"{promised} | {d['shown_mass']:.2f} |")
+    return lines
 
 
 def plot_success_vs_signals(records: list[dict], methods: list[str], budget: int, out: Path) -> Path:
