@@ -128,3 +128,19 @@ def test_decide_records_what_each_answer_taught():
     assert len(rows) == 2 and {"answer", "kl_bits", "gain_bits", "shown_mass", "top"} <= set(rows[0])
     assert all(r["kl_bits"] >= 0 for r in rows) and rows[0]["answer"] in result.answers
     assert get_signal("stop").name == "stop"
+
+
+def test_the_bench_reads_the_belief_on_a_hidden_goal_without_telling_the_learner():
+    from activeintent.runner import RunOptions, build_episode
+
+    options = RunOptions(method="decide-stop", intention="truth-03", env="symbolic", llm="none", video="none",
+                         budget=2, seed=1, test_scenes=1, test_pool=0)
+    episode = build_episode(options)
+    key = episode.intention.goal.key
+    prior = episode.learner.mass_of(key)
+    assert prior > 0 and not hasattr(episode.learner, "intention")
+    bits = episode.run().diagnostics["truth_bits"]
+    assert len(bits) == 3 and bits[0] == pytest.approx(-np.log2(prior), abs=1e-4)
+    assert bits[-1] == pytest.approx(-np.log2(episode.learner.mass_of(key)), abs=1e-4)
+    plain = build_episode(options.model_copy(update={"method": "bayes-stop"})).run()
+    assert "truth_bits" not in plain.diagnostics

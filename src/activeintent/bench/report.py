@@ -208,7 +208,11 @@ def answer_diagnostics(records: list[dict]) -> dict | None:
     for a in rows:
         kinds[a["answer"]].append(a)
     promised = [a["gain_bits"] for a in rows if a.get("gain_bits") is not None]
+    curves = [b for r in records if (b := (r.get("diagnostics") or {}).get("truth_bits"))]
+    drops = [(b[0] - b[-1]) / (len(b) - 1) for b in curves if len(b) > 1 and b[0] is not None and b[-1] is not None]
     return {
+        "truth_drop": float(np.mean(drops)) if drops else None,  # −log₂ p(true goal), per answer
+        "truth_n": len(drops),
         "n": len(rows),
         "episodes": sum(bool((r.get("diagnostics") or {}).get("answers")) for r in records),
         "share": {k: len(v) / len(rows) for k, v in sorted(kinds.items())},
@@ -233,14 +237,17 @@ def diagnostics_section(records: list[dict], methods: list[str]) -> list[str]:
                           "Pooled over the episodes of a suite. bits/answer: KL(posterior ‖ prior) of one "
                           "answer, in bits (the learner's own belief and answer model); promised: the gain the "
                           "query was chosen for (EIG or decision information, bits); P(shown): the belief's "
-                          "chance, before the answer, that the scene could show its goals.", "",
+                          "chance, before the answer, that the scene could show its goals; truth: the mean "
+                          "drop of −log₂ p(true goal) per answer (hidden goals of the language, episodes where "
+                          "the learner held the goal from the start; n = episodes).", "",
                           "| suite | method | answers (episodes) | answers by kind | bits/answer | bits by kind "
-                          "| promised | P(shown) |", "|---|---|---|---|---|---|---|---|"]
+                          "| promised | P(shown) | truth |", "|---|---|---|---|---|---|---|---|---|"]
             share = ", ".join(f"{k} {v:.0%}" for k, v in d["share"].items())
             by_kind = ", ".join(f"{k} {v:.2f}" for k, v in d["bits_by_kind"].items())
             promised = "–" if d["promised"] is None else f"{d['promised']:.2f}"
+            truth = "–" if d["truth_drop"] is None else f"{d['truth_drop']:.2f} (n={d['truth_n']})"
             lines.append(f"| {suite} | {m} | {d['n']} ({d['episodes']}) | {share} | {d['bits']:.2f} | {by_kind} | "
-                         f"{promised} | {d['shown_mass']:.2f} |")
+                         f"{promised} | {d['shown_mass']:.2f} | {truth} |")
     return lines
 
 

@@ -269,6 +269,34 @@ def truth_intentions() -> list[GoalIntention]:
     return out
 
 
+class TruthTracker:
+    """Episode observer (evaluation side only): −log₂ of the belief the learner holds on the
+    hidden goal itself, at k = 0 and after every answer, into ``diagnostics.truth_bits`` (None
+    where the learner does not hold the goal's key). The learner is read, never told."""
+
+    def __init__(self, learner, goal: Goal):
+        self.learner, self.key, self.bits = learner, goal.key, []
+
+    def _read(self) -> None:
+        p = self.learner.mass_of(self.key)
+        self.bits.append(None if not p else round(-float(np.log2(p)), 4))
+
+    def started(self, episode) -> None:
+        self._read()
+
+    def answered(self, log) -> None:
+        self._read()
+
+    def finished(self, result) -> None:
+        result.diagnostics["truth_bits"] = self.bits
+
+
+def truth_tracker(learner, intention) -> TruthTracker | None:
+    """A tracker when the hidden intention is a goal and the learner can say its mass on one."""
+    goal = getattr(intention, "goal", None)
+    return TruthTracker(learner, goal) if isinstance(goal, Goal) and hasattr(learner, "mass_of") else None
+
+
 def write(data: dict, path: Path = PATH) -> None:
     path.write_text(json.dumps(data, indent=1, ensure_ascii=False) + "\n")
 

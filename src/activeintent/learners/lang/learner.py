@@ -166,6 +166,11 @@ class LangLearner(BayesLearner):
                 self.log[-1]["neighbours_added"] = n
         return out
 
+    def mass_of(self, key: str) -> float:
+        """w of the goal with this key (0 when the belief does not hold it)."""
+        hit = [i for i, h in enumerate(self.hyps) if h.name == key]
+        return float(self.weights[hit].sum()) if hit else 0.0
+
     def stats(self) -> dict:
         out = super().stats()
         w = self.weights
