@@ -7,7 +7,8 @@
   "new scene" answer (lang's), with the decision gain;
 - ``decide-goal-gain-<signal>``: scenes from the belief, queries by EIG about z (lang's gain);
 - ``decide-shown-gain-<signal>``: scenes from the belief, EIG about z without what the scene's
-  feasibility tells.
+  feasibility tells;
+- ``decide-no-needs-<signal>``: no belief over what the intention needs of a scene's objects.
 """
 
 from activeintent.learners.lang.learner import DECIDE, LangConfig, LangLearner
@@ -17,6 +18,7 @@ ABLATIONS = {
     "random-scenes": {"scenes": "random"},
     "goal-gain": {"gain": "goal"},
     "shown-gain": {"gain": "shown"},
+    "no-needs": {"needs": False},
 }
 
 

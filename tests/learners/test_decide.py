@@ -11,7 +11,11 @@ from activeintent.envs.symbolic import SymbolicEnv
 from activeintent.episode import Episode, EpisodeConfig
 from activeintent.learners.bayes.acquisition import select_query
 from activeintent.learners.bayes.candidates import Outcome
-from activeintent.learners.bayes.decision import class_information, decision_classes, deployment_states
+from activeintent.learners.bayes.decision import (
+    class_information,
+    decision_classes,
+    deployment_states,
+)
 from activeintent.learners.lang.expr import parse_goal
 from activeintent.learners.lang.hypotheses import LangSpace
 from activeintent.learners.lang.learner import DECIDE, LangConfig, LangLearner
@@ -113,7 +117,7 @@ def _rounds(config: LangConfig, seed: int = 3) -> list[tuple]:
     return seen
 
 
-@pytest.mark.parametrize("switch", [{"scenes": "random"}, {"gain": "goal"}, {"gain": "shown"}])
+@pytest.mark.parametrize("switch", [{"scenes": "random"}, {"gain": "goal"}, {"gain": "shown"}, {"needs": False}])
 def test_every_switch_changes_the_questions(switch):
     assert _rounds(LangConfig(**{**DECIDE, **switch})) != _rounds(LangConfig(**DECIDE))
 

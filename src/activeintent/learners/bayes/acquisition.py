@@ -24,6 +24,7 @@ from pydantic import BaseModel
 from activeintent import ranking
 from activeintent.learners.bayes.candidates import Outcome
 from activeintent.learners.bayes.decision import class_information
+from activeintent.learners.bayes.needs import p_new_scene
 from activeintent.signals import Judge, Signal
 from activeintent.world import describe_plan
 
@@ -39,9 +40,10 @@ def eig(weights: np.ndarray, probs: np.ndarray) -> float:
     return float(_entropy(weights @ probs) - weights @ _entropy(probs))
 
 
-def with_new_scene(probs: np.ndarray, feasible: np.ndarray, error: float) -> np.ndarray:
-    """Append the answer "new scene" to P(h | z): P = 1 − ε where z cannot be shown, ε where it can."""
-    p_new = np.where(feasible, error, 1 - error)[:, None]
+def with_new_scene(probs: np.ndarray, feasible: np.ndarray, error: float, refuse: float = 0.0) -> np.ndarray:
+    """Append the answer "new scene" to P(h | z): P = 1 − ε where z cannot be shown, ε where it can
+    (with ``refuse`` = q(s) > 0, the needs belief's doubt: needs.py)."""
+    p_new = p_new_scene(feasible, error, refuse)[:, None]
     return np.concatenate([probs * (1 - p_new), p_new], axis=1)
 
 
@@ -95,6 +97,7 @@ def select_query(
     cap: int = 4000,
     gain: str = "goal",
     classes: np.ndarray | None = None,
+    refuse: float = 0.0,
 ) -> Query | None:
     """The query (``signal.shows`` distinct outcomes) with the largest EIG; ``choose="random"``
     picks uniformly among the candidates instead (same planner, same belief update). EIG is
@@ -119,18 +122,18 @@ def select_query(
         if classes is not None:
             classes = np.unique(classes[idx], return_inverse=True)[1].reshape(-1)
     if gain == "shown":
-        p_shown = (1 - new_scene_error) * float(weights @ feasible) + new_scene_error * float(weights @ ~feasible)
-        w_shown = weights * np.where(feasible, 1 - new_scene_error, new_scene_error)
-        w_shown = w_shown / w_shown.sum()
+        p_answer = 1 - p_new_scene(feasible, new_scene_error, refuse)
+        p_shown = float(weights @ p_answer)
+        w_shown = weights * p_answer / p_shown
     gains = np.empty(len(combos))
     for n, combo in enumerate(combos):
         probs = signal.predictive([outs[i].traj for i in combo], judge, model)
         if gain == "shown":
             g = p_shown * eig(w_shown, probs)
         elif gain == "decision":
-            g = class_information(weights, with_new_scene(probs, feasible, new_scene_error), classes)  # type: ignore[arg-type]
+            g = class_information(weights, with_new_scene(probs, feasible, new_scene_error, refuse), classes)  # type: ignore[arg-type]
         else:
-            g = eig(weights, with_new_scene(probs, feasible, new_scene_error))
+            g = eig(weights, with_new_scene(probs, feasible, new_scene_error, refuse))
         # Among (near-)equal gains prefer short plans: they are quicker to watch.
         gains[n] = g - 1e-4 * sum(len(outs[i].plan) for i in combo)
     order = ranking.order(gains)

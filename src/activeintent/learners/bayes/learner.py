@@ -33,6 +33,7 @@ from activeintent.learners.bayes.decision import decision_classes, deployment_st
 from activeintent.learners.bayes.facts import facts
 from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space, random_scene
 from activeintent.learners.bayes.judge import HypothesisJudge
+from activeintent.learners.bayes.needs import Needs, p_new_scene
 from activeintent.llm.base import ChatModel, ModelError
 from activeintent.signals import Answer, Signal, answer_kind_from_dump, get_signal
 from activeintent.world import (
@@ -72,6 +73,8 @@ class BayesConfig(BaseModel):
         "answers to the shown trajectories tell (the feasibility part of the EIG left out); decision: "
         "information about which plans to run on scenes of the public test distribution (decision.py)")
     deploy_scenes: int = Field(8, ge=1, description="gain = decision: the learner's own scenes of the test distribution")
+    needs: bool = Field(False, description="also learn what the intention needs of a scene's objects from "
+                        "'new scene' answers (needs.py)")
     top_k: int = Field(16, ge=1, description="plans come from this many most probable hypotheses")
     explore: int = Field(6, ge=0, description="... plus this many random other hypotheses")
     max_plans: int = Field(36, ge=2, description="candidate plans per scene")
@@ -92,6 +95,7 @@ class Observation:
     answer: Answer
     shown: list[Trajectory]
     texts: list[str] = field(default_factory=list)  # what was shown, in words (for proposals)
+    refuse: float = 0.0  # q(s) when answered: the needs belief's P(the scene lacks what is needed)
 
     @property
     def feedback(self) -> Answer:  # the name proposals.py reads
@@ -131,6 +135,7 @@ class BayesLearner(Learner):
         self.prior_entropy = self.belief.entropy_bits()
         self._drained = 0
         self._classes: tuple[tuple[int, int], np.ndarray] | None = None
+        self.needs = Needs(self.config.new_scene_error) if self.config.needs else None
         self.deploy = (deployment_states(int(self.rng.integers(2**31)), self.config.deploy_scenes)
                        if self.config.gain == "decision" else [])
 
@@ -185,7 +190,12 @@ class BayesLearner(Learner):
         feasible = self.judge.feasible(tuple(state.positions))  # the planner may have found some z infeasible
         return select_query(self.sig, self.model, self.judge, self.weights, feasible, outs,
                             c.new_scene_error, self.rng, choose=c.choose, gain=c.gain,
-                            classes=self.decision_classes() if c.gain == "decision" else None)
+                            classes=self.decision_classes() if c.gain == "decision" else None,
+                            refuse=self.refuse(tuple(state.positions)))
+
+    def refuse(self, objects: tuple[str, ...]) -> float:
+        """q(s): P(the scene lacks what the intention needs) under the needs belief (0 without one)."""
+        return 0.0 if self.needs is None else self.needs.refuse(objects)
 
     def decision_classes(self) -> np.ndarray:
         """z grouped by the plans that satisfy them on the learner's deployment scenes (once per
@@ -222,7 +232,8 @@ class BayesLearner(Learner):
                 if z.can_show(tuple(scene.objects)):
                     break
             drawn.append(scene)
-        mass = np.array([sum(w[j] for j, i in enumerate(likely) if self.hyps[i].can_show(tuple(s.objects)))
+        mass = np.array([(1 - self.refuse(tuple(s.objects)))
+                         * sum(w[j] for j, i in enumerate(likely) if self.hyps[i].can_show(tuple(s.objects)))
                          for s in drawn])
         keep = ranking.order(mass)[:c.n_scenes]  # most likely to be shown; ties to the first drawn
         yield from (drawn[i] for i in sorted(keep))
@@ -258,6 +269,11 @@ class BayesLearner(Learner):
     def _likelihood(self, obs: Observation, hyps: tuple[Hypothesis, ...], judge_) -> np.ndarray:
         feasible = judge_.feasible(obs.scene.objects)
         e = self.config.new_scene_error
+        if obs.refuse:  # the needs belief doubts the scene: a "new scene" says less about z
+            p_new = p_new_scene(feasible, e, obs.refuse)
+            if obs.answer.new_scene:
+                return p_new
+            return self.sig.likelihood(obs.answer, obs.shown, judge_, self.model) * (1 - p_new)
         if obs.answer.new_scene:
             return np.where(feasible, e, 1 - e)
         lik = self.sig.likelihood(obs.answer, obs.shown, judge_, self.model)
@@ -278,11 +294,13 @@ class BayesLearner(Learner):
         texts = ([f"{k}: {describe_state(t.outcome)}" for k, t in zip("AB", trajectories, strict=False)]
                  if self.sig.shows > 1 else
                  [f"step {s.index + 1}: {describe_skill(s.skill)}" for t in trajectories for s in t.steps])
-        obs = Observation(record.scene, answer, list(trajectories), texts)
+        obs = Observation(record.scene, answer, list(trajectories), texts, self.refuse(tuple(record.scene.objects)))
         lik = self._likelihood(obs, self.hyps, self.judge)
         before = self.weights
         shown = self.shown_mass(record.scene)
         evidence = self.belief.update(lik)
+        if self.needs is not None:
+            self.needs.update(tuple(record.scene.objects), answer.new_scene, shown)
         gain = record.estimate.why.get("eig_nats") if record.estimate is not None else None
         self.answer_log.append({
             "answer": answer_kind(answer),
@@ -290,6 +308,7 @@ class BayesLearner(Learner):
             "gain_bits": None if gain is None else round(gain / math.log(2), 4),  # what the query promised
             "shown_mass": round(shown, 4),  # the belief's P(the scene can show z) before the answer
             "top": [(h.name, round(p, 4)) for h, p in self.top(3)],
+            **({} if self.needs is None else {"refuse": round(obs.refuse, 4), "needs": self.needs.top(2)}),
         })
         self.observations.append(obs)
         surprised = not answer.new_scene and evidence < self.config.surprise * float(lik.max())

@@ -189,7 +189,7 @@ class LangLearner(BayesLearner):
 # ``decide-<signal>``: questions about what the robot will do (issue "Questions worth a person's
 # answer"): scenes the belief expects to show its goals, queries scored by what their answer
 # tells about the decision (examples/decide_ablation.py switches each part off).
-DECIDE = {"scenes": "belief", "gain": "decision"}
+DECIDE = {"scenes": "belief", "gain": "decision", "needs": True}
 
 
 def lang_method(signal: str, prefix: str = "lang"):
