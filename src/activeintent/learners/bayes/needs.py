@@ -5,7 +5,7 @@ no goal of the space states ("every block must have a rainbow colour", "at least
 Beside the belief over z the learner keeps a belief v over requirements R on the object set:
 conjunctions of at most ``MAX_LITERALS`` literals (``LITERALS``: at least 3 / 4 blocks, at least
 2 / 3 bowls, a block of colour c, no block of colour c, a bowl of colour c, every block's own
-bowl). Prior from description length: the number of literals k is geometric, P(k) ∝ 2^-(k+1),
+bowl, a warm / cool block, no warm / cool block). Prior from description length: the number of literals k is geometric, P(k) ∝ 2^-(k+1),
 and the k literals are uniform among the sets of that size.
 
 Mean-field answer model (z and R independent): with ε the assumed error of a "new scene" answer,
@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-from activeintent.world import COLOR_NAMES, Scene
+from activeintent.world import COLOR_NAMES, WARM_COLORS, Scene
 from activeintent.world.scene import color_of, kind_of
 
 MAX_LITERALS = 3
@@ -36,6 +36,7 @@ def _literals() -> list[tuple[str, object]]:
     out: list[tuple[str, object]] = [("blocks>=", 3), ("blocks>=", 4), ("bowls>=", 2), ("bowls>=", 3)]
     out += [("block", c) for c in COLOR_NAMES] + [("no-block", c) for c in COLOR_NAMES]
     out += [("bowl", c) for c in COLOR_NAMES] + [("own-bowls", None)]
+    out += [("class", "warm"), ("class", "cool"), ("no-class", "warm"), ("no-class", "cool")]
     return out
 
 
@@ -45,6 +46,7 @@ LITERALS = _literals()
 def literal_truth(objects: tuple[str, ...]) -> np.ndarray:
     """Which literals hold for a scene of these objects."""
     blocks = {color_of(o) for o in objects if kind_of(o) == "block"}
+    classes = {"warm" if c in WARM_COLORS else "cool" for c in blocks}
     bowls = {color_of(o) for o in objects if kind_of(o) == "bowl"}
     n_blocks = sum(kind_of(o) == "block" for o in objects)
     n_bowls = sum(kind_of(o) == "bowl" for o in objects)
@@ -60,6 +62,10 @@ def literal_truth(objects: tuple[str, ...]) -> np.ndarray:
             out.append(arg not in blocks)
         elif kind == "bowl":
             out.append(arg in bowls)
+        elif kind == "class":
+            out.append(arg in classes)
+        elif kind == "no-class":
+            out.append(arg not in classes)
         else:
             out.append(blocks <= bowls)
     return np.array(out, bool)
