@@ -147,10 +147,11 @@ def build_episode(
                            test_scenes=options.test_scenes, test_pool=options.test_pool, new_scene=options.new_scene, curve=options.curve,
                            video=options.video, stop_when_done=options.stop_when_done)
     observers = list(observers or [])
-    from activeintent.bench.truth_goals import truth_tracker
+    if getattr(intention, "goal", None) is not None:  # a goal as the hidden intention: track p(goal)
+        from activeintent.bench.truth_goals import truth_tracker
 
-    if (tracker := truth_tracker(learner, intention)) is not None:
-        observers.append(tracker)
+        if (tracker := truth_tracker(learner, intention)) is not None:
+            observers.append(tracker)
     return Episode(learner, intention, user, executor, env or make_env(options.env), config, observers,
                    usage=models.usage, model_time=models.model_time,
                    extra_config={"options": options.model_dump(mode="json")}, out_dir=out_dir)

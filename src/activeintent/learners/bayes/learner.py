@@ -33,7 +33,7 @@ from activeintent.learners.bayes.decision import decision_classes, deployment_st
 from activeintent.learners.bayes.facts import facts
 from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space, random_scene
 from activeintent.learners.bayes.judge import HypothesisJudge
-from activeintent.learners.bayes.needs import Needs, p_new_scene
+from activeintent.learners.bayes.needs import Needs, p_answered, p_new_scene
 from activeintent.llm.base import ChatModel, ModelError
 from activeintent.signals import Answer, Signal, answer_kind_from_dump, get_signal
 from activeintent.world import (
@@ -269,15 +269,10 @@ class BayesLearner(Learner):
     def _likelihood(self, obs: Observation, hyps: tuple[Hypothesis, ...], judge_) -> np.ndarray:
         feasible = judge_.feasible(obs.scene.objects)
         e = self.config.new_scene_error
-        if obs.refuse:  # the needs belief doubts the scene: a "new scene" says less about z
-            p_new = p_new_scene(feasible, e, obs.refuse)
-            if obs.answer.new_scene:
-                return p_new
-            return self.sig.likelihood(obs.answer, obs.shown, judge_, self.model) * (1 - p_new)
-        if obs.answer.new_scene:
-            return np.where(feasible, e, 1 - e)
+        if obs.answer.new_scene:  # with a needs belief that doubts the scene, it says less about z
+            return p_new_scene(feasible, e, obs.refuse)
         lik = self.sig.likelihood(obs.answer, obs.shown, judge_, self.model)
-        return lik * np.where(feasible, 1 - e, e)
+        return lik * p_answered(feasible, e, obs.refuse)
 
     def _log_lik(self, judge: HypothesisJudge) -> np.ndarray:
         """Σ_k log P(h_k | z) over every answer so far, for the hypotheses ``judge`` judges

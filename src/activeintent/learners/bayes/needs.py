@@ -120,7 +120,7 @@ class Needs:
 
     def describe(self, i: int) -> str:
         lits = [LITERALS[j] for j in self.index[i] if j < len(LITERALS)]
-        return " & ".join(f"{k}{'' if a is None else a}" if k.endswith("=") else f"{k}{'' if a is None else ':' + str(a)}"
+        return " & ".join(f"{k}{a}" if k.endswith("=") else k if a is None else f"{k}:{a}"
                           for k, a in lits) or "nothing"
 
 
@@ -129,3 +129,11 @@ def p_new_scene(feasible: np.ndarray, error: float, refuse: float = 0.0) -> np.n
     if refuse == 0.0:
         return np.where(feasible, error, 1 - error)
     return np.where(feasible, refuse * (1 - error) + (1 - refuse) * error, 1 - error)
+
+
+def p_answered(feasible: np.ndarray, error: float, refuse: float = 0.0) -> np.ndarray:
+    """1 − P(new scene | z): the user answers about what was shown (written out for q = 0, so the
+    learners without a needs belief keep their exact values)."""
+    if refuse == 0.0:
+        return np.where(feasible, 1 - error, error)
+    return 1 - p_new_scene(feasible, error, refuse)
