@@ -48,3 +48,49 @@ def test_unreachable_model_exits_3(tmp_path):
                         env={"OPENAI_API_KEY": "test"})
     assert res.exit_code == 3, res.output
     assert "model" in res.output.lower()
+
+
+def test_a_method_that_needs_no_model_gets_none_unless_asked(tmp_path, monkeypatch):
+    """`run` without --llm: bayes-stop needs no model, so none is loaded (its optional proposal
+    calls would otherwise run, and fail, unasked); methods that need one still get embedded."""
+    from activeintent.llm import registry as llm_registry
+    from activeintent.options import llm_for_method
+
+    loaded = []
+    monkeypatch.setattr(llm_registry, "load_model", lambda spec, **kw: loaded.append(spec))
+    out = tmp_path / "run"
+    res = runner.invoke(app, ["run", "--method", "bayes-stop", "--env", "symbolic", "--budget", "1",
+                              "--test-scenes", "2", "--test-pool", "0", "--video", "none", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    assert loaded == []
+    assert json.loads((out / "summary.json").read_text())["config"]["options"]["llm"] == "none"
+    assert "no model (--llm none)" in " ".join(res.output.split())
+    assert llm_for_method("preference", None) == "embedded"
+    assert llm_for_method("bayes-stop", "embedded") == "embedded"
+
+
+def test_failed_model_calls_show_while_running_and_in_the_summary(tmp_path):
+    res = runner.invoke(app, ["run", "--method", "bayes-stop", "--llm", "openai:gpt-x", "--base-url",
+                              "http://127.0.0.1:9/v1", "--cache-mode", "off", "--budget", "1", "--env", "symbolic",
+                              "--test-scenes", "2", "--test-pool", "0", "--video", "none", "--out", str(tmp_path)],
+                        env={"OPENAI_API_KEY": "test"})
+    text = " ".join(res.output.split())
+    assert "model call failed" in text and "nothing answers at http://127.0.0.1:9/v1" in text
+    assert res.exit_code == 3  # the model never answered
+    from activeintent.commands import model_summary
+
+    assert "2 failed" in model_summary("embedded", 5, ["timeout", "timeout"])
+    assert model_summary("none", 0, []) == "no model (--llm none)"
+
+
+def test_run_prints_a_line_per_signal_when_stdout_is_not_a_terminal(tmp_path):
+    """CliRunner's stdout is not a terminal, as in `run | cat`: one line per signal, before the table."""
+    res = runner.invoke(app, ["run", "--method", "bayes-stop", "--llm", "none", "--env", "symbolic", "--budget", "2",
+                              "--test-scenes", "2", "--test-pool", "0", "--video", "none", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    lines = res.output.splitlines()
+    progress = [i for i, line in enumerate(lines) if line.startswith("signal ")]
+    assert [lines[i].split(" · ")[0] for i in progress] == ["signal 0/2", "signal 1/2", "signal 2/2"]
+    assert "success@1 = " in lines[progress[1]] and "ETA" in lines[progress[1]]
+    table = next(i for i, line in enumerate(lines) if "bayes-stop on a hidden intention" in line)
+    assert progress[-1] < table

@@ -32,20 +32,48 @@ def methods() -> None:
 
 
 class LiveTable:
-    """An episode observer: a rich table of rounds (z, y, h, r) and a progress bar of signals."""
+    """An episode observer: a rich table of rounds (z, y, h, r) and a progress bar of signals.
+    With ``lines`` (stdout is not a terminal) it also prints one flushed line per signal, and it
+    always prints each failed model call as it happens (a learner that keeps going without its
+    optional model would otherwise show the failure only in summary.json)."""
 
-    def __init__(self, console, method: str, budget: int, seed: int):
+    def __init__(self, console, method: str, budget: int, seed: int, llm: str = "", lines: bool = False):
         from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
         from rich.table import Table
 
-        self.table = Table(title=f"{method} on a hidden intention · budget {budget} signals · seed {seed}", expand=True)
+        model = "no model" if llm in ("", "none") else f"model {llm}"
+        self.table = Table(title=f"{method} on a hidden intention · budget {budget} signals · seed {seed} · {model}",
+                           expand=True)
         for col, style in (("round", "bold"), ("z (estimated intention)", "cyan"), ("y (shown)", ""),
                            ("h (answer)", "magenta"), ("r (retrieved)", "dim"), ("success@k", "green")):
             self.table.add_column(col, style=style, overflow="fold")
         self.progress = Progress(TextColumn("signals"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
                                  TimeElapsedColumn(), console=console)
         self.task = self.progress.add_task("signals", total=budget)
+        self.console, self.budget, self.lines = console, budget, lines
+        self.eta = None
+        self.model_errors: list[str] = []
+        self._learner = None
         self._pending = None
+
+    def started(self, episode) -> None:
+        from activeintent.progress_lines import Eta
+
+        self._learner = episode.learner
+        self.eta = Eta(self.budget)
+
+    def _say(self, text: str) -> None:
+        from activeintent.progress_lines import print_line
+
+        print_line(self.console, text)
+
+    def _report_model_errors(self) -> None:
+        from rich.markup import escape
+
+        errors = list(getattr(self._learner, "proposal_errors", None) or [])
+        for err in errors[len(self.model_errors):]:
+            self._say(f"[red]model call failed[/red] (the learner goes on without it): {escape(err)}")
+        self.model_errors = errors
 
     def answered(self, log) -> None:
         from rich.markup import escape
@@ -59,17 +87,27 @@ class LiveTable:
             text += " (free)"
         goals = "\n".join(f"{lab}: {g}" for lab, g in zip(log.labels, log.goals, strict=False))
         self._pending = [str(log.round), escape(log.z), escape(goals), text, escape(log.retrieved or "")]
+        self._report_model_errors()
         if not log.counted:
             self.table.add_row(*self._pending, "")
+            if self.lines:
+                self._say(f"round {log.round} · answer {text} · z = “{escape(log.z)}”")
             self._pending = None
         self.progress.update(self.task, completed=log.signals_used)
 
     def scored(self, k: int, rate) -> None:
+        shown = "–" if rate is None else f"{rate:.2f}"
         if self._pending is not None:
-            self.table.add_row(*self._pending, "–" if rate is None else f"{rate:.2f}")
+            self.table.add_row(*self._pending, shown)
+            if self.lines:
+                round_, z, _, answer, _ = self._pending
+                self._say(f"signal {k}/{self.budget} · round {round_} · answer {answer} · z = “{z}” · "
+                          f"success@{k} = {shown} · {self.eta.text(k)}")
             self._pending = None
         elif k == 0:
-            self.table.add_row("0", "(prior, before any signal)", "", "", "", "–" if rate is None else f"{rate:.2f}")
+            self.table.add_row("0", "(prior, before any signal)", "", "", "", shown)
+            if self.lines:
+                self._say(f"signal 0/{self.budget} · prior, before any signal · success@0 = {shown}")
 
 
 def run(
@@ -85,7 +123,7 @@ def run(
     user: opt.User = D.user,
     new_scene: opt.NewScene = D.new_scene,
     prior: opt.Prior = D.prior,
-    llm: opt.Llm = D.llm,
+    llm: opt.LlmForMethod = None,
     vlm: opt.Vlm = None,
     base_url: opt.BaseUrl = None,
     cache: opt.Cache = None,
@@ -101,13 +139,18 @@ def run(
     out: opt.Out = None,
 ) -> None:
     """Run one episode: the learner asks, a simulated user with a hidden intention answers."""
+    from contextlib import nullcontext
+
     from rich.console import Console, Group
     from rich.live import Live
+    from rich.markup import escape
 
     from activeintent.llm.base import ModelError
+    from activeintent.progress_lines import print_line
     from activeintent.runner import DEFAULT_INTENTION, build_episode
 
     console = Console()
+    llm = opt.llm_for_method(method, llm, plugin)
     if unsafe_no_isolation:
         from activeintent.act.isolation import allow_unsafe_no_isolation
 
@@ -125,7 +168,7 @@ def run(
         raise typer.Exit(2) from None
     name = intention or (Path(intention_file.split(":")[0]).stem if intention_file else DEFAULT_INTENTION)
     out_dir = out or Path("runs") / f"{method}-{name}-seed{seed}"
-    live = LiveTable(console, method, budget, seed)
+    live = LiveTable(console, method, budget, seed, llm=llm, lines=not console.is_terminal)
     if opt.check_only():
         try:
             from activeintent.runner import check_options
@@ -138,10 +181,13 @@ def run(
             raise typer.Exit(2) from None
         return
     try:
+        if live.lines:  # a log sees a live display only at the end: plain lines instead
+            print_line(console, f"loading models and simulator… ({'no model' if llm == 'none' else 'model ' + llm})")
         with console.status("loading models and simulator…"):
             episode = build_episode(options, out_dir, observers=[live])
-        with Live(Group(live.table, live.progress), console=console, refresh_per_second=4,
-                  transient=not console.is_terminal):
+        shown = nullcontext() if live.lines else Live(Group(live.table, live.progress), console=console,
+                                                      refresh_per_second=4)
+        with shown:
             result = episode.run()
     except (ValueError, FileNotFoundError) as err:
         console.print(f"[red]error:[/red] {err}")
@@ -159,12 +205,24 @@ def run(
         raise typer.Exit(3)
     errors = result.learner_stats.get("proposal_errors") or []
     if errors and result.llm_calls == 0:
-        console.print(f"[red]model error:[/red] the model never answered ({errors[0]})")
+        console.print(f"[red]model error:[/red] the model never answered ({escape(errors[0])})")
         raise typer.Exit(3)
     rate = "n/a (no test scene feasible)" if result.success is None else f"{result.success:.2f}"
     console.print(
         f"success@{result.budget} = {rate} on {result.test_scored or 0} test scenes "
         f"({result.test_excluded} excluded: the hidden intention cannot be shown there) · "
-        f"{result.method} on {result.intention} · final z = “{result.final_z}” · {result.signals_used} signals "
-        f"{dict(result.answers)} · {result.llm_calls} model calls · {result.wall_s:.0f} s · {out_dir}/summary.json"
-    )
+        f"{result.method} on {result.intention} · final z = “{escape(result.final_z)}” · {result.signals_used} signals "
+        f"{dict(result.answers)} · {model_summary(llm, result.llm_calls, errors)} · {result.wall_s:.0f} s · "
+        f"{out_dir}/summary.json", soft_wrap=True)
+
+
+def model_summary(llm: str, calls: int, errors: list[str]) -> str:
+    """What the summary line says about the model: none, or its calls and, in red, the failed ones."""
+    from rich.markup import escape
+
+    if llm == "none":
+        return "no model (--llm none)"
+    text = f"model {escape(llm)}: {calls} calls"
+    if errors:
+        text += f", [red]{len(errors)} failed[/red] (first: {escape(errors[0][:120])})"
+    return text

@@ -40,9 +40,9 @@ def _apply_preset(preset: str, methods: str, intentions: str, budget: int) -> tu
 
 def bench(
     methods: Annotated[str, typer.Option("--methods", help="Comma-separated methods (default: bayes-preference, bayes-stop and the baselines)")] = "",
-    suite: Annotated[str, typer.Option("--suite", help="Comma-separated suites: paper, library, heldout, dev, truth-goals")] = "paper",
+    suite: Annotated[str | None, typer.Option("--suite", help="Comma-separated suites: paper, library, heldout, dev, truth-goals (default: paper, unless --intentions or --intention-file name what to run)")] = None,
     intentions: Annotated[str, typer.Option("--intentions", help="Comma-separated intentions (instead of --suite)")] = "",
-    intention_file: Annotated[list[str] | None, typer.Option("--intention-file", help="Add your own: path.py:NAME (repeatable)")] = None,
+    intention_file: Annotated[list[str] | None, typer.Option("--intention-file", help="Your own: path.py:NAME (repeatable); alone it runs just these, with --suite or --intentions it adds them")] = None,
     plugin: opt.Plugin = None,
     preset: Annotated[str | None, typer.Option("--preset", help="table1: the paper's Table 1 (preference, mllm, mllm-llm; the paper's four intentions; 5 trials; K = 5)")] = None,
     trials: Annotated[int | None, typer.Option("--trials", min=1, help="Episodes per method and intention (default 20; --preset table1: 5)")] = None,
@@ -75,14 +75,6 @@ def bench(
     """Compare methods on identical work under the honest protocol; writes results.jsonl,
     report.md and success_vs_signals.png."""
     from rich.console import Console
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
 
     from activeintent.bench.backends import check_backend
     from activeintent.bench.report import plot_success_vs_signals, write_report
@@ -105,11 +97,16 @@ def bench(
         method_list = _split(methods) or ["bayes-preference", "bayes-stop", "zero-signal", "random-query"]
         for m in method_list:
             check_options(run.model_copy(update={"method": m}))
+        if suite is None:  # the paper suite only when nothing else says what to run
+            suite = "" if intentions or intention_file else "paper"
         intention_list = _split(intentions) or [i for s in _split(suite) for i in suite_names(s)]
+        labels = {f: resolve(None, f).name for f in intention_file or []}  # the report names each by its name
         for name in intention_list:
+            if name in labels.values():
+                spec = next(f for f, n in labels.items() if n == name)
+                raise ValueError(f"{name!r} is the intention of --intention-file {spec}, which runs it already; "
+                                 "drop it from --intentions")
             resolve(name)
-        for f in intention_file or []:
-            resolve(None, f)
         if not intention_list and not intention_file:
             raise ValueError("no intentions to run: give --suite, --intentions or --intention-file")
     except (ValueError, FileNotFoundError) as err:
@@ -121,32 +118,79 @@ def bench(
                            trials=trials, seed=seed, jobs=jobs, backend=backend, ray_address=ray_address,
                            retry_errors=retry_errors,
                            keep_episodes=keep_episodes, run=run)
+    names = {**{i: i for i in intention_list}, **labels}
+    try:
+        if console.is_terminal:
+            records = _run_with_progress_bar(console, options, out, names)
+        else:  # a log sees a live bar only at the end: a flushed line per episode instead
+            records = run_bench(options, out, _ProgressLines(console, names))
+    except ValueError as err:
+        console.print(f"[red]error:[/red] {err}")
+        raise typer.Exit(2) from None
+    settings = {**protocol_fields(run), "trials": trials, "seed": seed, **({"preset": preset} if preset else {})}
+    all_intentions = intention_list + list(intention_file or [])
+    report = write_report(records, method_list, all_intentions, out, settings, labels=labels)
+    plot_success_vs_signals(records, method_list, budget, out, labels=labels, settings=settings)
+    console.print(report.read_text(), markup=False, soft_wrap=True)
+    console.print(f"report: {out / 'report.md'}  plot: {out / 'success_vs_signals.png'}", markup=False)
+
+
+def _outcome(record: dict) -> str:
+    s = record.get("success")
+    return "[red]error[/red]" if record.get("error") else ("–" if s is None else f"{s:.2f}")
+
+
+class _ProgressLines:
+    """``on_done`` for a non-terminal: one flushed line per finished episode, with done/total,
+    method, intention, trial, success@K, elapsed time and ETA."""
+
+    def __init__(self, console, names: dict[str, str]):
+        self.console, self.names, self.eta = console, names, None
+
+    def __call__(self, record: dict, finished: int, total: int) -> None:
+        from rich.markup import escape
+
+        from activeintent.progress_lines import Eta, print_line
+
+        if self.eta is None:  # the first call: episodes already in the folder
+            self.eta = Eta(total, done_before=finished)
+            print_line(self.console, f"bench: {total - finished} episodes to run"
+                       + (f" ({finished} of {total} already done)" if finished else ""))
+        if not record:
+            return
+        error = f" — {escape(record['error'])}" if record.get("error") else ""
+        print_line(self.console, f"{finished}/{total} · {record['method']} · "
+                   f"{escape(self.names.get(record['intention'], record['intention']))} · trial {record['trial']} · "
+                   f"success {_outcome(record)}{error} · {self.eta.text(finished)}")
+
+
+def _run_with_progress_bar(console, options, out: Path, names: dict[str, str]) -> list[dict]:
+    """A terminal: a live bar with ETA, a line above it per finished episode."""
+    from rich.markup import escape
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    from activeintent.bench.runner import run_bench
+
     progress = Progress(TextColumn("[bold]bench"), BarColumn(), MofNCompleteColumn(), TextColumn("episodes"),
                         TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(), TextColumn("{task.description}"),
-                        console=console, transient=not console.is_terminal)
+                        console=console)
     with progress:
         task = progress.add_task("", total=len(options.items()))
 
         def on_done(record: dict, finished: int, total: int) -> None:
             if record:
-                s = record.get("success")
-                mark = "[red]error[/red]" if record.get("error") else ("–" if s is None else f"{s:.2f}")
-                if console.is_terminal or record.get("error"):
-                    progress.console.print(f"{mark} {record['method']} · {record['intention']} · trial {record['trial']}"
-                                           + (f" — {record['error']}" if record.get("error") else ""))
-                progress.update(task, completed=finished, description=f"last: {record['method']}/{record['intention']}")
+                name = escape(names.get(record["intention"], record["intention"]))
+                progress.console.print(f"{_outcome(record)} {record['method']} · {name} · trial {record['trial']}"
+                                       + (f" — {escape(record['error'])}" if record.get("error") else ""))
+                progress.update(task, completed=finished, description=f"last: {record['method']}/{name}")
             else:
                 progress.update(task, completed=finished)
 
-        try:
-            records = run_bench(options, out, on_done)
-        except ValueError as err:
-            progress.stop()
-            console.print(f"[red]error:[/red] {err}")
-            raise typer.Exit(2) from None
-    settings = {**protocol_fields(run), "trials": trials, "seed": seed, **({"preset": preset} if preset else {})}
-    all_intentions = intention_list + list(intention_file or [])
-    report = write_report(records, method_list, all_intentions, out, settings)
-    plot_success_vs_signals(records, method_list, budget, out)
-    console.print(report.read_text(), markup=False)
-    console.print(f"report: {out / 'report.md'}  plot: {out / 'success_vs_signals.png'}", markup=False)
+        return run_bench(options, out, on_done)

@@ -39,9 +39,18 @@ def perf_bench(
         def answered(self, log) -> None:
             self.learner_s.append(log.timing.get("learner_s", 0.0))
 
+    from rich.console import Console
+
+    from activeintent.progress_lines import Eta, print_line
+
     names = [n.strip() for n in intentions.split(",") if n.strip()]
+    env_names = [e.strip() for e in envs.split(",") if e.strip()]
+    # One flushed line per episode on stderr (stdout stays the JSON), so a log shows it is alive.
+    log = Console(stderr=True)
+    eta = Eta(len(env_names) * len(names) * episodes)
+    done = 0
     out: dict = {"method": method, "episodes": episodes, "intentions": names, "budget": budget, "settings": {}}
-    for env in [e.strip() for e in envs.split(",") if e.strip()]:
+    for env in env_names:
         walls, phases, rounds = [], [], RoundTimes()
         for name in names:
             for seed in range(episodes):
@@ -56,6 +65,9 @@ def perf_bench(
                     episode.env.close()
                 walls.append(time.perf_counter() - start)
                 phases.append(result.time_split)
+                done += 1
+                print_line(log, f"{done}/{eta.total} · {method} · {env} · {name} · seed {seed} · "
+                           f"{walls[-1]:.1f} s · {eta.text(done)}")
         keys = phases[0].keys()
         out["settings"][env] = {
             "episode_s_median": round(statistics.median(walls), 3),
@@ -68,6 +80,4 @@ def perf_bench(
     if as_json:
         typer.echo(json.dumps(out, indent=2))
         return
-    from rich.console import Console
-
     Console().print_json(json.dumps(out))

@@ -35,6 +35,53 @@ def our_model(method: str, settings: dict) -> str:
     return str(llm)
 BASELINES = ("zero-signal", "random-query", "random-query-preference")
 
+# One colour per method in every figure of every report, fixed by name (not by the order a
+# bench lists its methods): the registered methods get their own tab20 entries (a baseline the
+# light shade of the learner whose belief it shares), any other name (a plug-in) one of the
+# remaining entries by a hash of its name.
+_TAB20 = ("#1f77b4", "#aec7e8", "#ff7f0e", "#ffbb78", "#2ca02c", "#98df8a", "#d62728", "#ff9896", "#9467bd",
+          "#c5b0d5", "#8c564b", "#c49c94", "#e377c2", "#f7b6d2", "#7f7f7f", "#c7c7c7", "#bcbd22", "#dbdb8d",
+          "#17becf", "#9edae5")
+METHOD_COLOURS = {
+    "bayes-stop": _TAB20[0], "random-query": _TAB20[1], "bayes-preference": _TAB20[2],
+    "random-query-preference": _TAB20[3], "lang-stop": _TAB20[4], "lang-preference": _TAB20[5],
+    "decide-stop": _TAB20[6], "decide-preference": _TAB20[7], "preference": _TAB20[8], "mllm": _TAB20[10],
+    "mllm-llm": _TAB20[12], "zero-signal": _TAB20[14],
+}
+_SPARE_COLOURS = tuple(c for c in _TAB20 if c not in METHOD_COLOURS.values())
+
+
+def method_colour(method: str) -> str:
+    """The method's colour, the same in every figure and run (hashlib, not hash(): that is salted per process)."""
+    import hashlib
+
+    if method in METHOD_COLOURS:
+        return METHOD_COLOURS[method]
+    return _SPARE_COLOURS[int(hashlib.sha256(method.encode()).hexdigest(), 16) % len(_SPARE_COLOURS)]
+
+
+def intention_label(intention: str, labels: dict[str, str] | None = None) -> str:
+    """How the report names an intention: its ``name`` for a path.py:NAME one when known."""
+    return (labels or {}).get(intention) or _short(intention)
+
+
+def _suite_title(suite: str, names: list[str], labels: dict[str, str] | None) -> str:
+    if suite == "file":
+        return "your intentions (" + ", ".join(intention_label(i, labels) for i in names) + ")"
+    return suite
+
+
+def protocol_title(intentions: list[str], settings: dict, labels: dict[str, str] | None = None) -> str:
+    """suite · user preset · K · trials · env, for titles of the report and its figures."""
+    by: dict[str, list[str]] = defaultdict(list)
+    for i in intentions:
+        by[suite_of(i)].append(i)
+    suites = ", ".join(_suite_title(s, n, labels) for s, n in by.items()) or "?"
+    parts = [f"suite {suites}", f"user {settings.get('user_preset', '?')}", f"K = {settings.get('budget', '?')} signals",
+             f"{settings.get('trials', '?')} trial{'' if settings.get('trials') == 1 else 's'}",
+             f"env {settings.get('env', '?')}"]
+    return " · ".join(parts)
+
 
 def wilson(successes: float, n: int, z: float = 1.96) -> tuple[float, float]:
     """95 % Wilson score interval of a proportion (successes may be fractional: mean × n)."""
@@ -74,6 +121,75 @@ def paired_difference(records: list[dict], a: str, b: str) -> dict | None:
             "wins": int((diffs > 1e-9).sum()), "ties": int((abs(diffs) <= 1e-9).sum()), "losses": int((diffs < -1e-9).sum())}
 
 
+def sign_test(wins: int, losses: int) -> float:
+    """Two-sided exact sign test (ties left out): the chance of a split at least this uneven
+    if either method were as likely to win."""
+    n = wins + losses
+    if n == 0:
+        return 1.0
+    tail = sum(math.comb(n, i) for i in range(min(wins, losses) + 1)) / 2**n
+    return min(1.0, 2 * tail)
+
+
+BOOTSTRAP_RESAMPLES = 2000
+
+
+def paired_bootstrap(diffs: np.ndarray, resamples: int = BOOTSTRAP_RESAMPLES, seed: int = 0) -> tuple[float, float]:
+    """95 % percentile interval of the mean paired difference, resampling pairs (fixed seed:
+    the same report from the same records)."""
+    rng = np.random.default_rng(seed)
+    means = diffs[rng.integers(0, len(diffs), size=(resamples, len(diffs)))].mean(axis=1)
+    return float(np.percentile(means, 2.5)), float(np.percentile(means, 97.5))
+
+
+def paired_comparison(records: list[dict], a: str, b: str) -> dict | None:
+    """``a`` against ``b`` on the same (intention, trial): the area difference of
+    :func:`paired_difference` with a sign test on it, and the success@K difference with a
+    paired-bootstrap interval."""
+    d = paired_difference(records, a, b)
+    if d is None:
+        return None
+    final = {m: {(r["intention"], r["trial"]): r["success"] for r in records if r["method"] == m and _ok(r)}
+             for m in (a, b)}
+    diffs = np.array([final[a][k] - final[b][k] for k in sorted(set(final[a]) & set(final[b]))])
+    lo, hi = paired_bootstrap(diffs)
+    return {**d, "p_sign": sign_test(d["wins"], d["losses"]), "final_mean": float(diffs.mean()),
+            "final_lo": lo, "final_hi": hi, "final_n": len(diffs)}
+
+
+def best_baseline(records: list[dict], methods: list[str]) -> str | None:
+    """The baseline of this bench with the highest mean success@K (the bar a learner must clear)."""
+    scores = {m: float(np.mean(v)) for m in methods if m in BASELINES
+              and (v := [r["success"] for r in records if r["method"] == m and _ok(r)])}
+    return max(scores, key=lambda m: (scores[m], -BASELINES.index(m))) if scores else None
+
+
+def paired_section(records: list[dict], methods: list[str]) -> list[str]:
+    """The fixed pairs (EIG against random questions, decide against lang) and every other
+    method against the best baseline, on the same trials."""
+    best = best_baseline(records, methods)
+    pairs = [(a, b) for a, b in PAIRED if a in methods and b in methods]
+    if best is not None:
+        pairs += [(m, best) for m in methods if m not in BASELINES and (m, best) not in pairs]
+    rows = [d for a, b in pairs if (d := paired_comparison(records, a, b))]
+    if not rows:
+        return []
+    against = f" and every method against the best baseline here, **{best}** (highest mean success@K)" if best else ""
+    lines = ["", "## Paired comparisons", "",
+             f"EIG against random questions, decide against lang{against}. Each episode of the method is paired "
+             "with the other method's episode on the same intention and trial (same query-scene seeds, user noise "
+             "and test scenes); n = pairs. Area: the mean of the episode's success@k over k = 0..K, difference "
+             "with a 95 % interval from the normal approximation of the paired mean; wins / ties / losses and "
+             "the two-sided sign test (ties left out) count episodes by that area. success@K: the difference at "
+             f"k = K with a 95 % paired-bootstrap interval ({BOOTSTRAP_RESAMPLES} resamples of the pairs).", "",
+             "| method − other | Δ area, mean [95 % interval] (n) | wins / ties / losses (area) | sign test p "
+             "| Δ success@K, mean [95 % bootstrap interval] |", "|---|---|---|---|---|"]
+    lines += [f"| {d['a']} − {d['b']} | {d['mean']:+.3f} [{d['lo']:+.3f}, {d['hi']:+.3f}] (n={d['n']}) | "
+              f"{d['wins']} / {d['ties']} / {d['losses']} | {d['p_sign']:.3g} | "
+              f"{d['final_mean']:+.3f} [{d['final_lo']:+.3f}, {d['final_hi']:+.3f}] |" for d in rows]
+    return lines
+
+
 def rate(values: list[float]) -> str:
     if not values:
         return "–"
@@ -92,7 +208,7 @@ def _short(intention: str) -> str:
 MIN_SCORED = 5  # an episode scored on fewer test scenes than this is named in the report
 
 
-def _scored_line(by: dict, methods: list[str], names: list[str]) -> str:
+def _scored_line(by: dict, methods: list[str], names: list[str], labels: dict[str, str] | None = None) -> str:
     """How many test scenes the suite's episodes were scored on at k = K, and which intentions
     had an episode scored on fewer than MIN_SCORED."""
     counts = {i: [r["test_scored"] for m in methods for r in by.get((m, i), [])
@@ -105,18 +221,29 @@ def _scored_line(by: dict, methods: list[str], names: list[str]) -> str:
             f"({len(every)} episodes).")
     if few:
         line += (f" Scored on fewer than {MIN_SCORED} in some episode (the intention can be shown in few scenes of "
-                 "the intention-independent test distribution): " + ", ".join(f"{_short(i)} (min {c})" for i, c in few.items()) + ".")
+                 "the intention-independent test distribution): " + ", ".join(f"{intention_label(i, labels)} (min {c})" for i, c in few.items()) + ".")
     else:
         line += f" Every episode was scored on at least {MIN_SCORED}."
     return line
 
 
-def write_report(records: list[dict], methods: list[str], intentions: list[str], out: Path, settings: dict) -> Path:
+COLUMNS = ("Columns: **intentions** and **all**: success@K, mean over episodes [95 % Wilson interval] "
+           "(n = scored episodes); **signals used**: mean counted answers per episode; **new-scene answers**: "
+           "\"new scene\" answers / all answers, summed over episodes; **test scenes excluded**: mean per episode "
+           "of the test scenes scored at k = K where the hidden intention cannot be shown, so left out of "
+           "success; **physics disagreements**: test scenes whose physics outcome differed from the symbolic "
+           "one, summed / episodes with physics; **errors**: episodes that ended in an error; **unscored**: "
+           "episodes with no feasible test scene (no success).")
+
+
+def write_report(records: list[dict], methods: list[str], intentions: list[str], out: Path, settings: dict,
+                 labels: dict[str, str] | None = None) -> Path:
+    """``labels``: the name of each path.py:NAME intention (the report shows names, not class names)."""
     by = defaultdict(list)
     for r in records:
         by[(r["method"], r["intention"])].append(r)
     budget = settings.get("budget")
-    lines = ["# activeintent benchmark", ""]
+    lines = [f"# activeintent benchmark — {protocol_title(intentions, settings, labels)}", ""]
     lines.append(
         f"success@{budget}: after exactly {budget} signals (every answer counts, \"new scene\" included "
         f"unless the protocol says otherwise) the learner's answer acts on each episode's test scenes; an "
@@ -138,8 +265,10 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
     for i in intentions:
         suites[suite_of(i)].append(i)
     for suite, names in suites.items():
-        lines += [f"## Suite: {suite}", ""]
-        lines += ["| method | " + " | ".join(_short(i) for i in names) + " | **all** | signals | new-scene answers | test scenes excluded | physics disagreements | errors | unscored |",
+        lines += [f"## Suite: {_suite_title(suite, names, labels)}", ""]
+        lines += ["| method | " + " | ".join(intention_label(i, labels) for i in names) + " | **all** | signals used "
+                  "(mean / episode) | new-scene answers (of all answers) | test scenes excluded (mean / episode) "
+                  "| physics disagreements (scenes / episodes) | errors (episodes) | unscored (episodes) |",
                   "|" + "---|" * (len(names) + 8)]
         for m in methods:
             every = [r for i in names for r in by.get((m, i), [])]
@@ -157,7 +286,7 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
                 label += " [" + "/".join(sorted({str(r.get("variant") or "structured") for r in ok})) + "]"
             lines.append(f"| {label} | " + " | ".join(cells) + f" | **{rate([r['success'] for r in ok])}** | "
                          f"{signals:.1f} | {new}/{total} | {excl:.1f} | {dis} | {errors} | {len(every) - len(ok) - errors} |")
-        lines += ["", _scored_line(by, methods, names)]
+        lines += ["", COLUMNS, "", _scored_line(by, methods, names, labels)]
         if suite == "paper":
             cols = [i for i in names if i in PAPER_TABLE1["preference"][0]]
             lines += ["", "The paper's Table 1 (people judged success, 5 trials, 5 signals) with our rows of the "
@@ -174,28 +303,33 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
                     lines.append(f"| {m} (ours) | {our_model(m, settings)} | {variants} | " + " | ".join(cells)
                                  + f" | {np.mean([r['success'] for r in ours]):.2f} |")
         lines.append("")
-    lines += ["## success@k (all suites pooled)", "", "| method | " + " | ".join(f"k={k}" for k in range((budget or 0) + 1)) + " |",
-              "|" + "---|" * ((budget or 0) + 2)]
-    for m in methods:
-        curves = [r["success_at"] for r in records if r["method"] == m and _ok(r) and r.get("success_at")]
-        cells = []
-        for k in range((budget or 0) + 1):
-            vals = [c[k] for c in curves if k < len(c) and c[k] is not None]
-            cells.append(f"{np.mean(vals):.2f}" if vals else "–")
-        lines.append(f"| {m} | " + " | ".join(cells) + " |")
-    pairs = [d for a, b in PAIRED if a in methods and b in methods and (d := paired_difference(records, a, b))]
-    if pairs:
-        lines += ["", "## Paired differences (EIG against random questions; decide against lang)", "",
-                  "Area under success@k (mean over k = 0..K) of each episode, minus that of the other method "
-                  "on the same intention and trial; mean [95 % interval], n = pairs.", "",
-                  "| method − baseline | difference in area | wins / ties / losses |", "|---|---|---|"]
-        lines += [f"| {d['a']} − {d['b']} | {d['mean']:+.3f} [{d['lo']:+.3f}, {d['hi']:+.3f}] (n={d['n']}) | "
-                  f"{d['wins']} / {d['ties']} / {d['losses']} |" for d in pairs]
+    lines += success_at_k_table(records, methods, budget or 0)
+    lines += paired_section(records, methods)
     lines += diagnostics_section(records, methods)
     lines += ["", "![success vs signals](success_vs_signals.png)", ""]
     path = out / "report.md"
     path.write_text("\n".join(lines))
     return path
+
+
+def success_at_k_table(records: list[dict], methods: list[str], budget: int) -> list[str]:
+    """success@k after every k, all suites pooled: mean [95 % Wilson interval], n = episodes."""
+    lines = ["## success@k (all suites pooled)", "",
+             "success of the learner's answer after k signals on the curve's test scenes (k = K: the whole pool), "
+             "mean over episodes [95 % Wilson interval]; n = episodes with a curve.", "",
+             "| method | n | " + " | ".join(f"k={k}" for k in range(budget + 1)) + " |", "|" + "---|" * (budget + 3)]
+    for m in methods:
+        curves = [r["success_at"] for r in records if r["method"] == m and _ok(r) and r.get("success_at")]
+        cells = []
+        for k in range(budget + 1):
+            vals = [c[k] for c in curves if k < len(c) and c[k] is not None]
+            if vals:
+                lo, hi = wilson(sum(vals), len(vals))
+                cells.append(f"{np.mean(vals):.2f} [{lo:.2f}, {hi:.2f}]")
+            else:
+                cells.append("–")
+        lines.append(f"| {m} | {len(curves)} | " + " | ".join(cells) + " |")
+    return lines
 
 
 def answer_diagnostics(records: list[dict]) -> dict | None:
@@ -251,43 +385,98 @@ def diagnostics_section(records: list[dict], methods: list[str]) -> list[str]:
     return lines
 
 
-def plot_success_vs_signals(records: list[dict], methods: list[str], budget: int, out: Path) -> Path:
-    """success@k against k for each method, with 95 % Wilson bands, one panel per suite."""
+PANEL_METHODS = 4  # more methods than this in one panel: small multiples
+
+
+def panel_groups(methods: list[str]) -> list[list[str]]:
+    """Methods per panel, at most PANEL_METHODS each: the baselines in every panel (the bar each
+    learner is read against), the other methods split over as few panels as needed."""
+    if len(methods) <= PANEL_METHODS:
+        return [list(methods)]
+    base = [m for m in methods if m in BASELINES]
+    rest = [m for m in methods if m not in BASELINES]
+    room = PANEL_METHODS - len(base)
+    if room < 1 or not rest:  # too many baselines to repeat: plain chunks
+        return [methods[i:i + PANEL_METHODS] for i in range(0, len(methods), PANEL_METHODS)]
+    return [rest[i:i + room] + base for i in range(0, len(rest), room)]
+
+
+def _curve_band(curves: list[list], budget: int) -> tuple[list[int], list[float], list[float], list[float]]:
+    ks, mean, lo, hi = [], [], [], []
+    for k in range(budget + 1):
+        vals = [c[k] for c in curves if k < len(c) and c[k] is not None]
+        if vals:
+            a, b = wilson(sum(vals), len(vals))
+            ks.append(k)
+            mean.append(float(np.mean(vals)))
+            lo.append(a)
+            hi.append(b)
+    return ks, mean, lo, hi
+
+
+def plot_success_vs_signals(records: list[dict], methods: list[str], budget: int, out: Path,
+                            labels: dict[str, str] | None = None, settings: dict | None = None) -> Path:
+    """success@k against k for each method with its 95 % Wilson band: a row per suite, small
+    multiples when more than PANEL_METHODS methods would share a panel; every method has its
+    :func:`method_colour`, the protocol is in the title."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.patches import Patch
+    from matplotlib.ticker import MaxNLocator
 
-    suites = sorted({suite_of(r["intention"]) for r in records}) or ["paper"]
-    fig, axes = plt.subplots(1, len(suites), figsize=(5.2 * len(suites), 4.0), dpi=120, squeeze=False)
-    for ax, suite in zip(axes[0], suites, strict=True):
-        drawn = False
-        for m in methods:
-            curves = [r["success_at"] for r in records
-                      if r["method"] == m and _ok(r) and r.get("success_at") and suite_of(r["intention"]) == suite]
+    def curves_of(m: str, suite: str) -> list[list]:
+        return [r["success_at"] for r in records
+                if r["method"] == m and _ok(r) and r.get("success_at") and suite_of(r["intention"]) == suite]
+
+    by_suite: dict[str, list[str]] = defaultdict(list)
+    for r in records:
+        if r["intention"] not in by_suite[suite_of(r["intention"])]:
+            by_suite[suite_of(r["intention"])].append(r["intention"])
+    # a suite none of whose episodes gave a curve would be an empty panel: left out
+    suites = [s for s in sorted(by_suite) if any(curves_of(m, s) for m in methods)]
+    groups = panel_groups(methods)
+    rows = [(s, g) for s in suites for g in groups if any(curves_of(m, s) for m in g)] or [("paper", methods)]
+    ncols = min(len(rows), 3)
+    nrows = math.ceil(len(rows) / ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(5.2 * ncols, 4.0 * nrows + 0.6), dpi=120, squeeze=False,
+                             sharey=True)
+    flat = [ax for row in axes for ax in row]
+    for ax, (suite, group) in zip(flat, rows, strict=False):
+        for m in group:
+            curves = curves_of(m, suite)
             if not curves:
                 continue
-            ks, mean, lo, hi = [], [], [], []
-            for k in range(budget + 1):
-                vals = [c[k] for c in curves if k < len(c) and c[k] is not None]
-                if vals:
-                    ks.append(k)
-                    mean.append(np.mean(vals))
-                    a, b = wilson(sum(vals), len(vals))
-                    lo.append(a)
-                    hi.append(b)
-            style = "--" if m in BASELINES else "-"
-            ax.plot(ks, mean, style, marker="o", ms=3, label=f"{m} (n={len(curves)})")
-            ax.fill_between(ks, lo, hi, alpha=0.12)
-            drawn = True
-        ax.set_title(f"suite: {suite}")
+            ks, mean, lo, hi = _curve_band(curves, budget)
+            colour = method_colour(m)
+            ax.plot(ks, mean, "--" if m in BASELINES else "-", marker="o", ms=3, color=colour,
+                    label=f"{m} (n={len(curves)})")
+            ax.fill_between(ks, lo, hi, color=colour, alpha=0.12, linewidth=0)
+        handles, names = ax.get_legend_handles_labels()
+        handles.append(Patch(color="grey", alpha=0.25, linewidth=0))
+        names.append("band: 95 % Wilson interval")
+        ax.legend(handles, names, loc="upper left", fontsize=7)
+        part = f" · panel {groups.index(group) + 1} of {len(groups)}" if len(groups) > 1 else ""
+        ax.set_title(f"suite: {_suite_title(suite, by_suite.get(suite, []), labels)}{part}", fontsize=10)
         ax.set_xlabel("signals given (k)")
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.set_ylim(-0.02, 1.02)
         ax.grid(alpha=0.3)
-        if drawn:
-            ax.legend(loc="upper left", fontsize=7)
-    axes[0][0].set_ylabel("success of the current answer (test scenes)")
-    fig.tight_layout()
+    for ax in flat[len(rows):]:
+        ax.set_visible(False)
+    for row in axes:
+        row[0].set_ylabel("success of the current answer (test scenes)")
+    intentions = [i for s in suites for i in by_suite[s]]
+    title = "success@k after k signals"
+    if settings:  # the protocol split over lines that fit the figure's width
+        import textwrap
+
+        title += "\n" + "\n".join(textwrap.wrap(protocol_title(intentions, settings, labels), 60 * ncols))
+    fig.suptitle(title, fontsize=9)
+    fig.text(0.5, 0.005, "lines: mean over episodes (dashed: baselines); bands: 95 % Wilson interval; "
+             "n = episodes", ha="center", fontsize=7)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
     path = out / "success_vs_signals.png"
     fig.savefig(path)
     plt.close(fig)

@@ -1,0 +1,62 @@
+"""`activeintent bench` through the CLI: what it runs for --intention-file, and progress lines
+on a non-terminal (CliRunner's stdout is not a terminal, as in `bench ... | cat`)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from activeintent.cli import app
+
+ROOT = Path(__file__).resolve().parents[2]
+MINE = f"{ROOT}/examples/my_intention.py:RightmostBowl"
+TINY = ["--env", "symbolic", "--llm", "none", "--budget", "1", "--trials", "1", "--test-scenes", "2",
+        "--test-pool", "0"]
+runner = CliRunner()
+
+
+def test_intention_file_alone_runs_just_that_intention_named_by_its_name(tmp_path):
+    out = tmp_path / "b"
+    res = runner.invoke(app, ["bench", "--methods", "zero-signal,bayes-stop", "--intention-file", MINE, *TINY,
+                              "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    records = [json.loads(line) for line in (out / "results.jsonl").read_text().splitlines()]
+    assert {r["intention"] for r in records} == {MINE} and len(records) == 2
+    assert json.loads((out / "bench.json").read_text())["intentions"] == []
+    report = (out / "report.md").read_text()
+    assert "| rightmost-bowl |" in report and "RightmostBowl |" not in report
+    # one flushed line per episode: done/total, method, intention, then elapsed and ETA
+    lines = [line for line in res.stdout.splitlines() if line.startswith(("1/2 · ", "2/2 · "))]
+    assert [line.split(" · ")[:3] for line in lines] == [["1/2", "zero-signal", "rightmost-bowl"],
+                                                        ["2/2", "bayes-stop", "rightmost-bowl"]]
+    assert all("elapsed " in line and "ETA " in line for line in lines)
+    assert res.stdout.index("2/2 · ") < res.stdout.index("# activeintent benchmark")
+
+
+def test_a_named_suite_still_runs_beside_an_intention_file(tmp_path, monkeypatch):
+    import activeintent.bench.runner as bench_runner
+    from activeintent.suites import suite
+
+    asked = []
+    monkeypatch.setattr(bench_runner, "run_bench", lambda options, out, on_done: asked.append(options) or [])
+    res = runner.invoke(app, ["bench", "--methods", "zero-signal", "--suite", "paper", "--intention-file", MINE,
+                              *TINY, "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    assert asked[0].intentions == suite("paper") and asked[0].intention_files == [MINE]
+
+
+def test_the_file_intention_name_in_intentions_says_what_to_do(tmp_path):
+    res = runner.invoke(app, ["bench", "--methods", "zero-signal", "--intention-file", MINE,
+                              "--intentions", "rightmost-bowl", *TINY, "--out", str(tmp_path)])
+    assert res.exit_code == 2
+    assert "--intention-file" in res.output and "drop it from --intentions" in " ".join(res.output.split())
+
+
+def test_perf_bench_prints_a_line_per_episode_on_stderr_and_keeps_stdout_json():
+    res = runner.invoke(app, ["perf-bench", "--json", "--episodes", "1", "--envs", "symbolic", "--budget", "1"])
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["settings"]["symbolic"]["signals"] == 1
+    line = next(line for line in res.stderr.splitlines() if line.startswith("1/1 · "))
+    assert line.split(" · ")[:4] == ["1/1", "bayes-stop", "symbolic", "color-match"] and "ETA" in line

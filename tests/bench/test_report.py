@@ -1,0 +1,146 @@
+"""The report and its figure: fixed colours, labelled bands, the protocol in the title, small
+multiples, intervals in every table, paired comparisons against the best baseline."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from activeintent.bench import report
+from activeintent.bench.report import (
+    BASELINES,
+    PANEL_METHODS,
+    method_colour,
+    paired_bootstrap,
+    panel_groups,
+    plot_success_vs_signals,
+    sign_test,
+    wilson,
+    write_report,
+)
+from activeintent.learners.registry import method_names
+
+SETTINGS = {"env": "symbolic", "user_preset": "human", "budget": 2, "trials": 4}
+
+
+def records_of(methods: list[str], intentions=("stack", "align"), trials: int = 4) -> list[dict]:
+    """Synthetic episodes: method i succeeds more the later it is listed, so comparisons have a sign."""
+    out = []
+    for i, m in enumerate(methods):
+        for intention in intentions:
+            for t in range(trials):
+                v = min(1.0, 0.1 * i + 0.05 * t)
+                out.append({"method": m, "intention": intention, "trial": t, "success": v,
+                            "success_at": [0.0, v / 2, v], "signals_used": 2, "answers": {"stop": 2}})
+    return out
+
+
+def plotted_colours(monkeypatch, methods: list[str], tmp_path) -> dict[str, str]:
+    """The colour each method's line was drawn in (a spy on Axes.plot)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.axes import Axes
+    from matplotlib.colors import to_hex
+
+    seen: dict[str, str] = {}
+    real = Axes.plot
+
+    def spy(self, *args, **kwargs):
+        lines = real(self, *args, **kwargs)
+        for line in lines:
+            seen[line.get_label().split(" (n=")[0]] = to_hex(line.get_color())
+        return lines
+
+    monkeypatch.setattr(Axes, "plot", spy)
+    tmp_path.mkdir(exist_ok=True)
+    plot_success_vs_signals(records_of(methods), methods, 2, tmp_path, settings=SETTINGS)
+    monkeypatch.undo()  # the next figure gets its own spy
+    return seen
+
+
+def test_a_method_has_the_same_colour_in_every_figure(monkeypatch, tmp_path):
+    one = plotted_colours(monkeypatch, ["bayes-stop", "zero-signal", "random-query"], tmp_path / "one")
+    two = plotted_colours(monkeypatch, ["lang-stop", "random-query", "bayes-preference", "bayes-stop"], tmp_path / "two")
+    assert set(one) == {"bayes-stop", "zero-signal", "random-query"}
+    for m in set(one) & set(two):
+        assert one[m] == two[m] == method_colour(m), m
+    registered = method_names()
+    assert len({method_colour(m) for m in registered}) == len(registered)  # no two registered methods share one
+    assert method_colour("my-plugin-method") == method_colour("my-plugin-method")
+
+
+def test_panels_hold_at_most_four_methods_with_the_baselines_in_each():
+    methods = ["bayes-stop", "bayes-preference", "lang-stop", "lang-preference", "decide-stop", "zero-signal",
+               "random-query"]
+    groups = panel_groups(methods)
+    assert len(groups) > 1 and all(len(g) <= PANEL_METHODS for g in groups)
+    assert sorted({m for g in groups for m in g}) == sorted(methods)
+    assert all({"zero-signal", "random-query"} <= set(g) for g in groups)
+    assert panel_groups(methods[:4]) == [methods[:4]]
+
+
+def test_the_figure_has_small_multiples_labelled_bands_and_the_protocol_in_its_title(monkeypatch, tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figures = []
+    monkeypatch.setattr(plt, "close", lambda fig: figures.append(fig))
+    methods = ["bayes-stop", "bayes-preference", "lang-stop", "lang-preference", "zero-signal"]
+    plot_success_vs_signals(records_of(methods), methods, 2, tmp_path, settings=SETTINGS)
+    fig = figures[0]
+    panels = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(panels) == 2
+    for ax in panels:
+        names = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert "band: 95 % Wilson interval" in names and len(names) - 1 <= PANEL_METHODS
+    title = fig._suptitle.get_text()
+    assert "suite paper" in title and "user human" in title and "K = 2" in title and "4 trials" in title
+
+
+CI = r"([0-9.]+) \[([0-9.]+), ([0-9.]+)\]"
+
+
+def test_success_at_k_cells_carry_wilson_intervals_and_the_title_the_protocol(tmp_path):
+    methods = ["bayes-stop", "zero-signal"]
+    records = records_of(methods)
+    text = write_report(records, methods, ["stack", "align"], tmp_path, SETTINGS).read_text()
+    assert text.splitlines()[0] == "# activeintent benchmark — suite paper · user human · K = 2 signals · 4 trials · env symbolic"
+    section = text.split("## success@k")[1].split("##")[0]
+    row = next(line for line in section.splitlines() if line.startswith("| bayes-stop |"))
+    cells = re.findall(CI, row)
+    assert len(cells) == 3 and "| 8 |" in row
+    for k, (mean, lo, hi) in enumerate(cells):
+        vals = [r["success_at"][k] for r in records if r["method"] == "bayes-stop"]
+        assert float(mean) == pytest.approx(round(float(np.mean(vals)), 2))
+        assert (float(lo), float(hi)) == pytest.approx(tuple(round(x, 2) for x in wilson(sum(vals), len(vals))))
+    header = next(line for line in text.splitlines() if line.startswith("| method | stack |"))
+    assert "test scenes excluded (mean / episode)" in header and "signals used (mean / episode)" in header
+    assert "**test scenes excluded**:" in text  # the column legend says what it counts
+
+
+def test_every_method_is_paired_against_the_best_baseline(tmp_path):
+    methods = ["bayes-stop", "lang-stop", "zero-signal", "random-query"]  # random-query scores best of the baselines
+    records = records_of(["zero-signal", "bayes-stop", "random-query", "lang-stop"])
+    assert report.best_baseline(records, methods) == "random-query"
+    text = write_report(records, methods, ["stack", "align"], tmp_path, SETTINGS).read_text()
+    section = text.split("## Paired comparisons")[1]
+    assert "best baseline here, **random-query**" in section
+    rows = [line for line in section.splitlines() if line.startswith("| ") and " − " in line and "method −" not in line]
+    assert [r.split(" | ")[0] for r in rows] == ["| bayes-stop − random-query", "| lang-stop − random-query"]
+    lang = rows[1]
+    assert "8 / 0 / 0" in lang and f"{sign_test(8, 0):.3g}" in lang
+    assert all(m not in BASELINES for m in ("bayes-stop", "lang-stop"))
+
+
+def test_sign_test_and_paired_bootstrap():
+    assert sign_test(8, 0) == pytest.approx(2 / 2**8)
+    assert sign_test(3, 3) == 1.0 and sign_test(0, 0) == 1.0
+    diffs = np.array([0.1, 0.2, 0.3, 0.2])
+    lo, hi = paired_bootstrap(diffs)
+    assert 0.1 <= lo <= diffs.mean() <= hi <= 0.3
+    assert paired_bootstrap(diffs) == (lo, hi)  # fixed seed: the same report from the same records
