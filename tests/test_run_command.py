@@ -50,25 +50,6 @@ def test_unreachable_model_exits_3(tmp_path):
     assert "model" in res.output.lower()
 
 
-def test_a_method_that_needs_no_model_gets_none_unless_asked(tmp_path, monkeypatch):
-    """`run` without --llm: bayes-stop needs no model, so none is loaded (its optional proposal
-    calls would otherwise run, and fail, unasked); methods that need one still get embedded."""
-    from activeintent.llm import registry as llm_registry
-    from activeintent.options import llm_for_method
-
-    loaded = []
-    monkeypatch.setattr(llm_registry, "load_model", lambda spec, **kw: loaded.append(spec))
-    out = tmp_path / "run"
-    res = runner.invoke(app, ["run", "--method", "bayes-stop", "--env", "symbolic", "--budget", "1",
-                              "--test-scenes", "2", "--test-pool", "0", "--video", "none", "--out", str(out)])
-    assert res.exit_code == 0, res.output
-    assert loaded == []
-    assert json.loads((out / "summary.json").read_text())["config"]["options"]["llm"] == "none"
-    assert "no model (--llm none)" in " ".join(res.output.split())
-    assert llm_for_method("preference", None) == "embedded"
-    assert llm_for_method("bayes-stop", "embedded") == "embedded"
-
-
 def test_failed_model_calls_show_while_running_and_in_the_summary(tmp_path):
     res = runner.invoke(app, ["run", "--method", "bayes-stop", "--llm", "openai:gpt-x", "--base-url",
                               "http://127.0.0.1:9/v1", "--cache-mode", "off", "--budget", "1", "--env", "symbolic",

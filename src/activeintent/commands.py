@@ -123,7 +123,7 @@ def run(
     user: opt.User = D.user,
     new_scene: opt.NewScene = D.new_scene,
     prior: opt.Prior = D.prior,
-    llm: opt.LlmForMethod = None,
+    llm: opt.Llm = D.llm,
     vlm: opt.Vlm = None,
     base_url: opt.BaseUrl = None,
     cache: opt.Cache = None,
@@ -150,7 +150,6 @@ def run(
     from activeintent.runner import DEFAULT_INTENTION, build_episode
 
     console = Console()
-    llm = opt.llm_for_method(method, llm, plugin)
     if unsafe_no_isolation:
         from activeintent.act.isolation import allow_unsafe_no_isolation
 

@@ -25,8 +25,6 @@ User = Annotated[str, typer.Option("--user", help="Simulated-user preset: human 
 NewScene = Annotated[str, typer.Option("--new-scene", help="counted (every answer is a signal) | free (old rule, ≤3 uncounted) | off")]
 Prior = Annotated[str, typer.Option("--prior", help="Bayesian prior: length (description length) | uniform")]
 Llm = Annotated[str, typer.Option("--llm", help="LLM: embedded | gguf:/path.gguf | openai:<model> | none (Bayesian methods and baselines)")]
-# `run`: no default spec, so a method that needs no model gets none unless one is asked for.
-LlmForMethod = Annotated[str | None, typer.Option("--llm", help="LLM: embedded | gguf:/path.gguf | openai:<model> | none. Default: embedded for methods that need a model, none for the others (see `activeintent methods`)")]
 Vlm = Annotated[str | None, typer.Option("--vlm", help="Multimodal model spec for the retriever (default: the LLM)")]
 BaseUrl = Annotated[str | None, typer.Option("--base-url", envvar="OPENAI_BASE_URL", help="OpenAI-compatible endpoint")]
 Cache = Annotated[str | None, typer.Option("--cache", help="Response cache file (SQLite); default ~/.cache/activeintent")]
@@ -47,24 +45,6 @@ def check_only() -> bool:
     import os
 
     return os.environ.get("ACTIVEINTENT_CHECK_ONLY") == "1"
-
-
-def llm_for_method(method: str, llm: str | None, plugins: list[str] | None = None) -> str:
-    """The model spec a run uses: ``llm`` when given, else ``embedded`` if the method needs a
-    model and ``none`` if it does not (an optional model changes what such a method does, and
-    its failures would otherwise surprise). An unknown method keeps the default; validation
-    names it later."""
-    if llm is not None:
-        return llm
-    from activeintent.learners.registry import get_method
-    from activeintent.registry import load_plugin
-
-    try:
-        for path in plugins or []:
-            load_plugin(path)
-        return D.llm if get_method(method).needs_llm else "none"
-    except (ValueError, FileNotFoundError):  # UnknownName is a ValueError
-        return D.llm
 
 
 def run_options(**values) -> RunOptions:
