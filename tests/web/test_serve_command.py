@@ -68,7 +68,8 @@ def test_serve_binds_loopback_and_answers(tmp_path):
                 break
             except httpx.TransportError:
                 time.sleep(0.2)
-        assert config == {"method": "bayes-stop", "signal": "stop", "rounds": 3, "design": "free-rule",
+        assert config == {"study": False, "consent": None, "require_pid": False,
+                          "url_parameters": ["pid", "PROLIFIC_PID", "STUDY_ID", "SESSION_ID"], "method": "bayes-stop", "signal": "stop", "rounds": 3, "design": "free-rule",
                           "intention": None, "intention_description": None, "show_estimate": "hidden",
                           "fps": 10, "video_size": [128, 128]}
         page = httpx.get(f"http://127.0.0.1:{port}/")

@@ -58,15 +58,30 @@ def wait_videos(page, *ids: str) -> None:
     )
 
 
-def start(page, url: str, participant: str, tmp_path: Path | None = None) -> str:
-    page.goto(url + "/")
+def enter(page, url: str, participant: str | None = None) -> None:
+    """Step 1 of the start page (consent, code); ends on step 2, what to do."""
+    page.goto(url)
+    page.wait_for_selector("#begin:enabled")
+    if participant is not None:
+        page.fill("#participant", participant)
+    page.click("#begin")
     page.wait_for_selector("#start:enabled")
-    page.fill("#participant", participant)
+
+
+def start(page, url: str, participant: str, tmp_path: Path | None = None) -> str:
+    enter(page, url + "/", participant)
     if tmp_path is not None:
         shot(page, tmp_path, "start")
     page.click("#start")
-    page.wait_for_url("**/*?session=*")
+    page.wait_for_function("location.pathname !== '/'")
     return session_id(page)
+
+
+def ready(page) -> None:
+    """Pass the round's ready gate (the videos play only then)."""
+    page.wait_for_selector("#ready:enabled")
+    page.click("#ready")
+    page.wait_for_selector("#gate", state="hidden")
 
 
 def test_two_round_preference_session(live_server, page, tmp_path):
@@ -76,6 +91,9 @@ def test_two_round_preference_session(live_server, page, tmp_path):
 
     wait_round(page, 1)
     wait_videos(page, "video-a", "video-b")
+    assert page.is_disabled('button[data-choice="A"]')  # nothing to answer before the videos played
+    assert page.evaluate("document.getElementById('video-a').paused")  # no autoplay: the gate first
+    ready(page)
     assert page.inner_text("#progress .label") == "Round 1 of 2"
     assert not page.is_visible("#estimate")  # the guess is hidden (the study's default)
     for v in ("video-a", "video-b"):  # autoplaying, looping videos
@@ -86,6 +104,8 @@ def test_two_round_preference_session(live_server, page, tmp_path):
 
     wait_round(page, 2)
     assert page.inner_text("#progress .label") == "Round 2 of 2"
+    page.keyboard.press("Enter")  # the gate's key
+    page.wait_for_selector('button[data-choice="cant_choose"]:enabled')
     page.click('button[data-choice="cant_choose"]')
 
     page.wait_for_url("**/done?session=*")
@@ -124,6 +144,7 @@ def test_clicker_session_stops_at_a_known_moment(live_server, page, tmp_path):
 
     wait_round(page, 1)
     wait_videos(page, "video")
+    ready(page)
     assert not page.evaluate("document.getElementById('video').loop")  # plays once
     video = srv.manager.get(sid).state()["question"]["videos"][0]
     fps = video["fps"]
@@ -148,6 +169,7 @@ def test_clicker_session_stops_at_a_known_moment(live_server, page, tmp_path):
 
     wait_round(page, 2)
     wait_videos(page, "video")
+    ready(page)
     assert page.is_disabled("#good")  # not before the video has ended
     page.evaluate(
         "() => { const v = document.getElementById('video'); v.currentTime = Math.max(0, v.duration - 0.3); v.play(); }"
@@ -201,14 +223,13 @@ def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server,
 
     # -- free rule: each participant picks a rule; the guess stays hidden; nothing is scored ----
     free = live_server("bayes-preference", rounds=1, seed=5, **small)
-    page.goto(free.url + "/")
-    page.wait_for_selector("#start:enabled")
+    enter(page, free.url + "/", "P-free")
     assert page.is_visible("#rule-free") and not page.is_visible("#rule-assigned")
-    page.fill("#participant", "P-free")
     page.click("#start")
     page.wait_for_url("**/preference?session=*")
     sid = session_id(page)
     wait_round(page, 1)
+    ready(page)
     # controls are named by what they do; the key hints are outside the names
     for name in ("A is better", "B is better", "Can't choose", "New scene"):
         assert page.get_by_role("button", name=name, exact=True).count() == 1, name
@@ -226,6 +247,7 @@ def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server,
     page.wait_for_url("**/done?session=*")
     page.wait_for_selector("#question:not(.hidden)")
     assert page.is_visible("#q-final")
+    ready(page)  # the final attempt has its gate too
     assert page.is_visible("#legend")  # colour names stay on once asked for
     answer_questionnaire(page, "partly", "Warm colours to the left", "The videos were clear.")
     assert not page.is_visible("#estimate")  # hidden study: not even the final guess
@@ -242,15 +264,14 @@ def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server,
     # -- assigned rule: told on the start page, guesses shown after each answer, stop kept ------
     assigned = live_server("bayes-stop", rounds=2, seed=6, intention="color-match", show_estimate="after-answer",
                            **small)
-    page.goto(assigned.url + "/")
-    page.wait_for_selector("#start:enabled")
+    enter(page, assigned.url + "/", "P-assigned")
     assert page.is_visible("#rule-assigned") and not page.is_visible("#rule-free")
     assert page.inner_text("#rule-text") == "Put each block in the bowl of the same colour."
-    page.fill("#participant", "P-assigned")
     page.click("#start")
     page.wait_for_url("**/clicker?session=*")
     sid = session_id(page)
     wait_round(page, 1)
+    ready(page)
     assert not page.is_visible("#feedback") and not page.is_visible("#estimate")  # no guess in round 1
     assert page.get_by_role("button", name="Stop the robot", exact=True).count() == 1
     wait_videos(page, "video")
