@@ -305,7 +305,8 @@ def create_app(
     @app.post("/api/sessions/{sid}/answer", summary="Answer the waiting round (names the round)")
     def post_answer(sid: str, body: Answer) -> dict:
         session = session_or_404(sid)
-        client = {"client_ts": body.client_ts, **({"time": body.time} if isinstance(body, StopAnswer) else {})}
+        client = {"client_ts": body.client_ts,
+                  **({"time": body.time, "viewing": body.viewing} if isinstance(body, StopAnswer) else {})}
         h = session.answer(body.round, _feedback_maker(session, body), client=client)
         return {"accepted": True, "round": body.round, "answer": h.model_dump(mode="json")}
 
