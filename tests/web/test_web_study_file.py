@@ -11,7 +11,14 @@ from fastapi.testclient import TestClient
 
 from activeintent.web.server import create_app
 from activeintent.web.session import StudyConfig
-from activeintent.web.study import Assigner, StudyFile, StudyFileError, button_order, check_pid, load_study
+from activeintent.web.study import (
+    Assigner,
+    StudyFile,
+    StudyFileError,
+    button_order,
+    check_pid,
+    load_study,
+)
 
 CONDITIONS = [{"name": "pref-hidden", "method": "bayes-preference", "intention": "color-match"},
               {"name": "stop-hidden", "method": "bayes-stop", "intention": "color-match"},
