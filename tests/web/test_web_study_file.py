@@ -121,3 +121,15 @@ def test_the_study_file_names_what_is_wrong(tmp_path):
     (tmp_path / "s.yaml").write_text("x")
     with pytest.raises(StudyFileError, match=".json or .toml"):
         load_study(tmp_path / "s.yaml")
+
+
+def test_the_final_guess_reports_the_learners_expected_success_when_no_belief_names_it():
+    from types import SimpleNamespace
+
+    from activeintent.web.session import guess_of
+
+    final = SimpleNamespace(z="Put each block in the bowl of the same colour.", why={"expected_success": 0.83})
+    g = guess_of(final, answers=2, belief_top=[["color-match", 0.6]])  # snapshots name rules, z is a description
+    assert g.confidence == 0.83 and g.kind == "expected_success" and "expected probability" in g.basis
+    none = guess_of(SimpleNamespace(z="z", why={}), answers=2)
+    assert none.confidence is None and none.kind is None
