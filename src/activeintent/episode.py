@@ -23,7 +23,7 @@ from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any, Literal, Protocol
 
 import numpy as np
 from pydantic import BaseModel, Field
@@ -195,8 +195,14 @@ class Episode:
         model_time: Callable[[], float] | None = None,
         extra_config: dict | None = None,
         out_dir: str | Path | None = None,
+        show_final: Literal["first", "first-feasible"] | None = None,
     ):
         self.learner, self.intention, self.user = learner, intention, user
+        # Opt-in (the web study): after the final scoring, emit ``final_shown`` with one test
+        # scene's physics execution, the first test scene ("first") or the first on which the
+        # intention can be shown at all ("first-feasible"). Not part of the records: None
+        # (the default) changes nothing.
+        self.show_final = show_final
         self.executor, self.env = executor, env
         self.config = config or EpisodeConfig()
         self.observers = list(observers or [])
@@ -260,6 +266,7 @@ class Episode:
         curve's); success over the feasible ones. Physics (a physics env, ``final`` only) runs on
         the curve's scenes."""
         physics = final and self.env.name != "symbolic"
+        shown = self._final_shown_index(tests) if physics and self.show_final else None
         logs = []
         for i, (scene, seed) in enumerate(tests if final else tests[:self.config.test_scenes]):
             physics_here = physics and i < self.config.test_scenes
@@ -280,6 +287,11 @@ class Episode:
                 self.emit("tested", k, i, scene, est, traj)
                 if i == 0 and self.config.video != "none":
                     self._video(traj, "final")
+            if i == shown:
+                if not physics_here:  # beyond the curve's scenes: run it for showing only, not scored
+                    self.clock.timed("env_s", self.env.reset, scene, seed)
+                    traj = self.clock.timed("env_s", self.env.execute, plan)
+                self.emit("final_shown", i, scene, est, traj, feasible)
             logs.append(log)
         self.learner.drain_transcript()  # scoring calls are not part of any round's record
         self._executor_calls()
@@ -287,6 +299,13 @@ class Episode:
         rate = float(np.mean(scored)) if scored else None
         self.emit("scored", k, rate)
         return rate, logs
+
+    def _final_shown_index(self, tests: list[tuple[Scene, int]]) -> int:
+        if self.show_final == "first-feasible":
+            for i, (scene, _) in enumerate(tests):
+                if self.intention.feasible(scene):
+                    return i
+        return 0  # "first", or no test scene can show the intention
 
     # -- the loop ------------------------------------------------------------------------------
     def run(self) -> EpisodeResult:

@@ -119,8 +119,10 @@ def build_episode(
     user=None,
     observers: list | None = None,
     env=None,
+    show_final: str | None = None,
 ) -> Episode:
-    """Everything before the loop starts. Errors in the options are raised here, before any work."""
+    """Everything before the loop starts. Errors in the options are raised here, before any work.
+    ``show_final``: see :class:`Episode` (the web study's final attempt; None for every run)."""
     from activeintent.act.base import make_executor
     from activeintent.envs import make_env
     from activeintent.learners.registry import LearnerContext, get_method
@@ -154,4 +156,5 @@ def build_episode(
             observers.append(tracker)
     return Episode(learner, intention, user, executor, env or make_env(options.env), config, observers,
                    usage=models.usage, model_time=models.model_time,
-                   extra_config={"options": options.model_dump(mode="json")}, out_dir=out_dir)
+                   extra_config={"options": options.model_dump(mode="json")}, out_dir=out_dir,
+                   show_final=show_final)

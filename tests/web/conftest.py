@@ -74,13 +74,21 @@ def live_server(tmp_path) -> Iterator:
     127.0.0.1 for this test (``limits``: a :class:`Limits` or its fields as a dict)."""
     servers: list[tuple[uvicorn.Server, threading.Thread]] = []
 
-    def start(method: str, rounds: int = 2, limits: Limits | dict | None = None, clock=None, **study) -> LiveServer:
+    def start(method: str, rounds: int = 2, limits: Limits | dict | None = None, clock=None, study_file=None,
+              **study) -> LiveServer:
         out = tmp_path / f"out-{len(servers)}"
         config = StudyConfig(method=method, signal=get_method(method).signal, rounds=rounds, out_dir=out, **study)
         if isinstance(limits, dict):
             limits = Limits(**limits)
+        conditions = None
+        if study_file is not None:  # a study file's conditions (method, rule, guess display)
+            conditions = {}
+            for c in study_file.conditions:
+                cfg = StudyConfig(method=c.method, signal=get_method(c.method).signal, rounds=rounds, out_dir=out,
+                                  intention=c.intention, show_estimate=c.show_estimate, **study)
+                conditions[c.name] = (cfg, runner_builder(cfg, llm="none", test_scenes=2))
         app = create_app(config, runner_builder(config, llm="none", test_scenes=2),  # Bayesian methods, no model
-                         limits=limits, clock=clock or time.monotonic)
+                         limits=limits, clock=clock or time.monotonic, study=study_file, conditions=conditions)
         port = _free_port()
         server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
         thread = threading.Thread(target=server.run, daemon=True)

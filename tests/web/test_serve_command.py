@@ -68,7 +68,8 @@ def test_serve_binds_loopback_and_answers(tmp_path):
                 break
             except httpx.TransportError:
                 time.sleep(0.2)
-        assert config == {"method": "bayes-stop", "signal": "stop", "rounds": 3, "design": "free-rule",
+        assert config == {"study": False, "consent": None, "require_pid": False,
+                          "url_parameters": ["pid", "PROLIFIC_PID", "STUDY_ID", "SESSION_ID"], "method": "bayes-stop", "signal": "stop", "rounds": 3, "design": "free-rule",
                           "intention": None, "intention_description": None, "show_estimate": "hidden",
                           "fps": 10, "video_size": [128, 128]}
         page = httpx.get(f"http://127.0.0.1:{port}/")
@@ -95,3 +96,25 @@ def _tcp_listeners() -> list[tuple[str, int]]:
             addr = ".".join(str(int(hex_addr[i:i + 2], 16)) for i in (6, 4, 2, 0))
             found.append((addr, int(hex_port, 16)))
     return found
+
+
+def test_serve_loads_a_study_file(tmp_path, monkeypatch):
+    import uvicorn
+
+    served = []
+    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: served.append(app))
+    study = tmp_path / "study.toml"
+    study.write_text('consent = "Agree?"\ncompletion_code = "C1"\n\n[[conditions]]\nname = "pref"\n'
+                     'method = "bayes-preference"\nintention = "color-match"\n\n[[conditions]]\nname = "stop"\n'
+                     'method = "bayes-stop"\nshow_estimate = "always"\n')
+    runner = CliRunner()
+    res = runner.invoke(app, ["serve", "--study", str(study), "--out", str(tmp_path / "out")])
+    assert res.exit_code == 0, res.output
+    manager = served[-1].state.manager
+    assert set(manager.conditions) == {"pref", "stop"} and manager.study.completion_code == "C1"
+    assert manager.conditions["stop"][0].show_estimate == "always" and manager.conditions["pref"][0].design == "assigned-rule"
+    res = runner.invoke(app, ["serve", "--study", str(study), "--method", "bayes-stop", "--out", str(tmp_path)])
+    assert res.exit_code != 0 and "set per condition" in res.output
+    study.write_text('consent = "x"\n[[conditions]]\nname = "a"\nmethod = "clicks"\n')
+    res = runner.invoke(app, ["serve", "--study", str(study), "--out", str(tmp_path)])
+    assert res.exit_code != 0 and "bayes-preference" in res.output

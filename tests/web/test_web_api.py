@@ -251,7 +251,8 @@ def test_openapi_describes_the_api(live_server):
             "/api/sessions/{sid}/events", "/api/sessions/{sid}/result", "/api/sessions/{sid}/questionnaire",
             "/api/sessions/{sid}/files/{name}"} <= paths
     config = httpx.get(f"{srv.url}/api/config").json()
-    assert config == {"method": "bayes-stop", "signal": "stop", "rounds": 1, "design": "free-rule",
+    assert config == {"study": False, "consent": None, "require_pid": False,
+                      "url_parameters": ["pid", "PROLIFIC_PID", "STUDY_ID", "SESSION_ID"], "method": "bayes-stop", "signal": "stop", "rounds": 1, "design": "free-rule",
                       "intention": None, "intention_description": None, "show_estimate": "hidden", "fps": 10,
                       "video_size": [480, 480]}
 

@@ -58,15 +58,30 @@ def wait_videos(page, *ids: str) -> None:
     )
 
 
-def start(page, url: str, participant: str, tmp_path: Path | None = None) -> str:
-    page.goto(url + "/")
+def enter(page, url: str, participant: str | None = None) -> None:
+    """Step 1 of the start page (consent, code); ends on step 2, what to do."""
+    page.goto(url)
+    page.wait_for_selector("#begin:enabled")
+    if participant is not None:
+        page.fill("#participant", participant)
+    page.click("#begin")
     page.wait_for_selector("#start:enabled")
-    page.fill("#participant", participant)
+
+
+def start(page, url: str, participant: str, tmp_path: Path | None = None) -> str:
+    enter(page, url + "/", participant)
     if tmp_path is not None:
         shot(page, tmp_path, "start")
     page.click("#start")
-    page.wait_for_url("**/*?session=*")
+    page.wait_for_function("location.pathname !== '/'")
     return session_id(page)
+
+
+def ready(page) -> None:
+    """Pass the round's ready gate (the videos play only then)."""
+    page.wait_for_selector("#ready:enabled")
+    page.click("#ready")
+    page.wait_for_selector("#gate", state="hidden")
 
 
 def test_two_round_preference_session(live_server, page, tmp_path):
@@ -76,6 +91,9 @@ def test_two_round_preference_session(live_server, page, tmp_path):
 
     wait_round(page, 1)
     wait_videos(page, "video-a", "video-b")
+    assert page.is_disabled('button[data-choice="A"]')  # nothing to answer before the videos played
+    assert page.evaluate("document.getElementById('video-a').paused")  # no autoplay: the gate first
+    ready(page)
     assert page.inner_text("#progress .label") == "Round 1 of 2"
     assert not page.is_visible("#estimate")  # the guess is hidden (the study's default)
     for v in ("video-a", "video-b"):  # autoplaying, looping videos
@@ -86,6 +104,8 @@ def test_two_round_preference_session(live_server, page, tmp_path):
 
     wait_round(page, 2)
     assert page.inner_text("#progress .label") == "Round 2 of 2"
+    page.keyboard.press("Enter")  # the gate's key
+    page.wait_for_selector('button[data-choice="cant_choose"]:enabled')
     page.click('button[data-choice="cant_choose"]')
 
     page.wait_for_url("**/done?session=*")
@@ -124,6 +144,7 @@ def test_clicker_session_stops_at_a_known_moment(live_server, page, tmp_path):
 
     wait_round(page, 1)
     wait_videos(page, "video")
+    ready(page)
     assert not page.evaluate("document.getElementById('video').loop")  # plays once
     video = srv.manager.get(sid).state()["question"]["videos"][0]
     fps = video["fps"]
@@ -148,6 +169,7 @@ def test_clicker_session_stops_at_a_known_moment(live_server, page, tmp_path):
 
     wait_round(page, 2)
     wait_videos(page, "video")
+    ready(page)
     assert page.is_disabled("#good")  # not before the video has ended
     page.evaluate(
         "() => { const v = document.getElementById('video'); v.currentTime = Math.max(0, v.duration - 0.3); v.play(); }"
@@ -201,14 +223,13 @@ def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server,
 
     # -- free rule: each participant picks a rule; the guess stays hidden; nothing is scored ----
     free = live_server("bayes-preference", rounds=1, seed=5, **small)
-    page.goto(free.url + "/")
-    page.wait_for_selector("#start:enabled")
+    enter(page, free.url + "/", "P-free")
     assert page.is_visible("#rule-free") and not page.is_visible("#rule-assigned")
-    page.fill("#participant", "P-free")
     page.click("#start")
     page.wait_for_url("**/preference?session=*")
     sid = session_id(page)
     wait_round(page, 1)
+    ready(page)
     # controls are named by what they do; the key hints are outside the names
     for name in ("A is better", "B is better", "Can't choose", "New scene"):
         assert page.get_by_role("button", name=name, exact=True).count() == 1, name
@@ -226,6 +247,7 @@ def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server,
     page.wait_for_url("**/done?session=*")
     page.wait_for_selector("#question:not(.hidden)")
     assert page.is_visible("#q-final")
+    ready(page)  # the final attempt has its gate too
     assert page.is_visible("#legend")  # colour names stay on once asked for
     answer_questionnaire(page, "partly", "Warm colours to the left", "The videos were clear.")
     assert not page.is_visible("#estimate")  # hidden study: not even the final guess
@@ -242,15 +264,14 @@ def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server,
     # -- assigned rule: told on the start page, guesses shown after each answer, stop kept ------
     assigned = live_server("bayes-stop", rounds=2, seed=6, intention="color-match", show_estimate="after-answer",
                            **small)
-    page.goto(assigned.url + "/")
-    page.wait_for_selector("#start:enabled")
+    enter(page, assigned.url + "/", "P-assigned")
     assert page.is_visible("#rule-assigned") and not page.is_visible("#rule-free")
     assert page.inner_text("#rule-text") == "Put each block in the bowl of the same colour."
-    page.fill("#participant", "P-assigned")
     page.click("#start")
     page.wait_for_url("**/clicker?session=*")
     sid = session_id(page)
     wait_round(page, 1)
+    ready(page)
     assert not page.is_visible("#feedback") and not page.is_visible("#estimate")  # no guess in round 1
     assert page.get_by_role("button", name="Stop the robot", exact=True).count() == 1
     wait_videos(page, "video")
@@ -300,3 +321,127 @@ def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server,
     assert row["questionnaire_final_attempt"] == "yes"
     assert row["questionnaire_rule"] == "Blocks into the bowl of their colour"
     assert row["questionnaire_comments"] is None and row["show_estimate"] == "after-answer"
+
+
+def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
+    """A participant from a Prolific-style link: consent, ready gates, a Stop pressed after the
+    video has ended (refused, on record), a stop in a replay, the questionnaire and the
+    completion code; the data hold the pid, the condition and a final table that can show the rule."""
+    import httpx
+
+    from activeintent.suites import resolve
+    from activeintent.web.study import StudyFile
+    from activeintent.world.scene import Scene
+
+    study = StudyFile(
+        consent="We ask you to teach a robot a rule.\n\nYou may stop at any time.", completion_code="DONE-7",
+        redirect_url="https://example.org/complete?cc=DONE-7", redirect_after_s=None, assignment_seed=2,
+        conditions=[{"name": "stop-after", "method": "bayes-stop", "intention": "color-match",
+                     "show_estimate": "after-answer"},
+                    {"name": "stop-always", "method": "bayes-stop", "intention": "color-match",
+                     "show_estimate": "always"}])
+    # seed 3: the first two test tables cannot show color-match, the third can
+    srv = live_server("bayes-stop", rounds=2, seed=3, study_file=study, video_size=(160, 160))
+    expected = srv.manager.assigner.tie_order[0]  # the first participant: all at 0, the seeded order decides
+    page.goto(f"{srv.url}/?pid=P-study-01&STUDY_ID=study42&SESSION_ID=visit9")
+    page.wait_for_selector("#begin:enabled")
+    assert page.is_visible("#consent") and "You may stop at any time." in page.inner_text("#consent-text")
+    assert page.inner_text("#pid-value") == "P-study-01" and not page.is_visible("#participant")
+    page.click("#begin")
+    page.wait_for_selector("#start:enabled")
+    text = page.inner_text("body").lower()
+    assert "bayes" not in text and "signal" not in text and expected not in text  # no method, no condition
+    page.click("#start")
+    page.wait_for_url("**/clicker?session=*")
+    sid = session_id(page)
+    api = f"{srv.url}/api/sessions/{sid}"
+    session = srv.manager.get(sid)
+    assert session.enrolment.condition == expected
+    assert session.config.show_estimate == study.condition(expected).show_estimate
+
+    # -- round 1: ready gate, the video ends, a late Stop, a stop in the replay --------------------
+    wait_round(page, 1)
+    wait_videos(page, "video")
+    assert page.is_visible("#gate") and page.is_disabled("#stop")
+    assert page.evaluate("document.getElementById('video').paused")  # nothing plays before Ready
+    order = [page.get_attribute(f"#answers button:nth-child({i})", "data-action") for i in (1, 2)]
+    assert order == session.enrolment.button_order
+    assert page.evaluate("new Set([...document.querySelectorAll('#answers button')].map(b => b.className)).size") == 1
+    page.keyboard.press("Enter")  # Ready
+    page.wait_for_selector('#question[data-phase="first"]')
+    page.evaluate("() => { const v = document.getElementById('video'); v.currentTime = v.duration - 0.05; }")
+    page.wait_for_selector('#question[data-phase="ended"]')
+    assert page.is_disabled("#stop") and page.is_enabled("#good")
+    page.keyboard.press("Space")  # too late: the video has ended
+    page.wait_for_function("document.getElementById('status').textContent.includes('no longer counts')")
+    assert page.is_visible("#replay")
+    video = session.state()["question"]["videos"][0]
+    # the server refuses it too: once the page said the video ended, and at the video's end
+    for _ in range(600):  # the page reports the end as it happens; wait for that report
+        if session.viewing(1)["ended"] is not None:
+            break
+        page.wait_for_timeout(50)
+    assert session.viewing(1)["ended"] is not None, "the page did not report the video's end"
+    late = httpx.post(f"{api}/answer", json={"kind": "stop", "round": 1, "action": "stop", "time": 1.0})
+    assert late.status_code == 422 and late.json()["error"]["code"] == "after_video_end"
+    at_end = httpx.post(f"{api}/answer", json={"kind": "stop", "round": 1, "action": "stop",
+                                               "time": video["duration"], "viewing": "replay"})
+    assert at_end.status_code == 422 and "at or after the end" in at_end.json()["error"]["message"]
+    page.click("#replay")
+    page.wait_for_selector('#question[data-phase="replay"]')
+    target = (int(0.4 * (video["frames"] - 1)) + 0.5) / video["fps"]
+    page.evaluate("""async (t) => {
+        const v = document.getElementById('video');
+        v.pause();
+        const seeked = new Promise(r => v.addEventListener('seeked', r, {once: true}));
+        v.currentTime = t;
+        await seeked;
+    }""", target)
+    page.keyboard.press("Space")  # a stop during the replay
+
+    # -- round 2: guess between rounds (after-answer) or above the video (always) ------------------
+    if session.config.show_estimate == "after-answer":
+        page.wait_for_selector("#feedback:visible")
+        page.get_by_role("button", name="Continue to round 2 of 2").click()
+    wait_round(page, 2)
+    wait_videos(page, "video")
+    ready(page)
+    page.evaluate("() => { const v = document.getElementById('video'); v.currentTime = v.duration - 0.05; }")
+    page.wait_for_selector("#good:enabled")
+    page.click("#good")
+
+    # -- the final attempt, the questionnaire, the completion code -------------------------------
+    page.wait_for_url("**/done?session=*")
+    page.wait_for_selector("#question:not(.hidden)")
+    assert page.is_visible("#gate")
+    ready(page)
+    answer_questionnaire(page, "partly", "Each block into the bowl of its colour", "")
+    page.wait_for_selector("#completion:visible")
+    assert page.inner_text("#completion-code") == "DONE-7"
+    assert page.get_attribute("#redirect-link", "href") == "https://example.org/complete?cc=DONE-7"
+    confidence = page.inner_text("#estimate .confidence")
+    assert "%" in confidence and "does not say" not in confidence  # the Bayesian learner's own confidence
+
+    assert session.join(60) and session.status == "finished", session.error
+    folder = srv.session_dir(sid)
+    info = json.loads((folder / "session.json").read_text())
+    assert info["pid"] == info["participant"] == "P-study-01" and info["condition"] == expected
+    assert info["study_id"] == "study42" and info["prolific_session_id"] == "visit9" and info["consented"]
+    rule = resolve("color-match", None)
+    assert info["final_scene_feasible"] is True and rule.feasible(Scene(objects=info["final_scene"]))
+    assert info["final_scene_index"] == 2  # the first test table where color-match can be shown
+    log = events(folder)
+    assert [e["round"] for e in log if e["type"] == "stop_after_end" and e["source"] == "client"] == [1]
+    assert sum(e["type"] == "stop_after_end" and e["source"] == "server" for e in log) == 2  # the refusals
+    rows = export(srv.out, tmp_path / "study.csv")
+    (row,) = rows
+    assert row["pid"] == row["participant"] == row["round1_participant"] == row["round2_participant"] == "P-study-01"
+    assert row["condition"] == expected and row["study_id"] == "study42"
+    assert row["button_order"] == " ".join(session.enrolment.button_order)
+    assert row["final_scene_feasible"] == "true" and row["final_scene_index"] == "2"
+    assert row["round1_answer"] == "stop" and row["round1_viewing"] == "replay"
+    assert row["round1_after_end_presses"] == "3" and row["round2_answer"] == "looks_good"
+    assert float(row["round1_stop_time"]) == pytest.approx(target, abs=1e-3)
+    # no stop time at or after the video's end
+    for r in read_rounds(folder / "rounds.jsonl"):
+        assert r["answer"]["stop_time"] is None or r["answer"]["stop_time"] < video["duration"] - 1e-9

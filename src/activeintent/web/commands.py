@@ -27,13 +27,14 @@ def register(app: typer.Typer) -> None:
 def serve(
     host: Annotated[str, typer.Option("--host", help="Address to bind (loopback unless told otherwise)")] = "127.0.0.1",
     port: Annotated[int, typer.Option("--port", min=0, max=65535, help="TCP port")] = 8000,
-    method: Annotated[str, typer.Option("--method", help="preference | mllm | mllm-llm | bayes-preference | bayes-stop")] = "bayes-preference",
+    method: Annotated[str | None, typer.Option("--method", help="preference | mllm | mllm-llm | bayes-preference | bayes-stop (default bayes-preference; with --study: the study file's conditions)")] = None,
     rounds: opt.Budget = D.budget,
     intention: Annotated[str | None, typer.Option("--intention", help="Assign this rule to every participant (shown on the start page; success is scored against it). Without it each participant picks their own rule and success is not scored (free-rule design)")] = None,
     intention_file: Annotated[str | None, typer.Option("--intention-file", help="Assign your own rule: path.py:NAME (as --intention)")] = None,
     seed: Annotated[int, typer.Option("--seed", help="Session n runs with seed + n")] = 0,
     out: Annotated[Path, typer.Option("--out", help="Sessions are saved in OUT/<session-id>/")] = Path("runs/web"),
-    show_estimate: Annotated[ShowEstimate, typer.Option("--show-estimate", help="The learner's current guess: never shown (hidden), shown between rounds after each answer (after-answer), or above the videos from round 2 on (always); never before the first answer")] = ShowEstimate.hidden,
+    show_estimate: Annotated[ShowEstimate | None, typer.Option("--show-estimate", help="The learner's current guess: never shown (hidden, the default), shown between rounds after each answer (after-answer), or above the videos from round 2 on (always); never before the first answer")] = None,
+    study: Annotated[Path | None, typer.Option("--study", help="A study file (.json or .toml): consent text, completion code and redirect, and the conditions (method × rule × guess display) participants are assigned to in a balanced way; replaces --method, --intention and --show-estimate")] = None,
     video_size: Annotated[int, typer.Option("--video-size", min=64, max=1024, help="Width and height of the videos in pixels (larger takes longer to render before each round)")] = 480,
     llm: opt.Llm = D.llm,
     vlm: opt.Vlm = None,
@@ -65,34 +66,76 @@ def serve(
     from activeintent.web.limits import Limits
     from activeintent.web.server import create_app, runner_builder
     from activeintent.web.session import StudyConfig
+    from activeintent.web.study import StudyFileError, load_study
 
     extra = dict(llm=llm, vlm=vlm, base_url=base_url, cache=cache,
                  cache_mode=cache_mode, executor=executor, retriever=retriever, plugins=list(plugin or []))
-    try:
-        # options and the assigned rule are checked now so a typo fails before anyone opens the page
-        check_options(opt.run_options(method=method, budget=rounds, intention=intention,
-                                      intention_file=intention_file, **extra))
-        rule = resolve_intention(intention, intention_file) if intention or intention_file else None
-        signal = get_method(method).signal
-    except (ValueError, IntentionError, FileNotFoundError) as err:
-        raise typer.BadParameter(str(err)) from None
-    config = StudyConfig(method=method, signal=signal, rounds=rounds,
-                         intention=rule.name if rule else None, intention_file=intention_file,
-                         intention_description=(rule.description or rule.name) if rule else None,
-                         show_estimate=show_estimate.value, video_size=(video_size, video_size), out_dir=out,
-                         seed=seed, answer_timeout=answer_timeout, max_sessions=max_sessions)
+    study_file = None
+    if study is not None:
+        given = [name for name, v in (("--method", method), ("--intention", intention),
+                                      ("--intention-file", intention_file), ("--show-estimate", show_estimate)) if v]
+        if given:
+            raise typer.BadParameter(f"{', '.join(given)}: set per condition in the study file, not here",
+                                     param_hint="--study")
+        try:
+            study_file = load_study(study)
+        except StudyFileError as err:
+            raise typer.BadParameter(str(err), param_hint="--study") from None
+        rounds = study_file.rounds or rounds
+        cells = [(c.name, c.method, c.intention, c.intention_file, c.show_estimate) for c in study_file.conditions]
+    else:
+        cells = [("single", method or "bayes-preference", intention, intention_file,
+                  (show_estimate or ShowEstimate.hidden).value)]
+    configs: dict[str, StudyConfig] = {}
+    for name, m, rule_name, rule_file, shown in cells:
+        try:
+            # options and the assigned rule are checked now so a typo fails before anyone opens the page
+            check_options(opt.run_options(method=m, budget=rounds, intention=rule_name,
+                                          intention_file=rule_file, **extra))
+            rule = resolve_intention(rule_name, rule_file) if rule_name or rule_file else None
+            signal = get_method(m).signal
+        except (ValueError, IntentionError, FileNotFoundError) as err:
+            where = f"condition {name}: " if study_file else ""
+            raise typer.BadParameter(where + str(err)) from None
+        configs[name] = StudyConfig(
+            method=m, signal=signal, rounds=rounds, intention=rule.name if rule else None, intention_file=rule_file,
+            intention_description=(rule.description or rule.name) if rule else None, show_estimate=shown,
+            video_size=(video_size, video_size), out_dir=out, seed=seed, answer_timeout=answer_timeout,
+            max_sessions=max_sessions)
+    config = next(iter(configs.values()))
     limits = Limits(max_sessions_per_client=max_sessions_per_client,
                     max_new_sessions_per_hour=max_new_sessions_per_hour, idle_timeout=idle_timeout * 60,
                     max_body_bytes=max_request_kb * 1024, events_quota_bytes=int(events_quota_mb * 2**20))
     if opt.check_only():
         return
-    app = create_app(config, runner_builder(config, **extra), limits=limits)
+    conditions = {name: (c, runner_builder(c, **extra)) for name, c in configs.items()} if study_file else None
+    try:
+        app = create_app(config, runner_builder(config, **extra), limits=limits, study=study_file,
+                         conditions=conditions)
+    except ValueError as err:  # e.g. an unreadable OUT/assignment.json
+        raise typer.BadParameter(str(err), param_hint="--out") from None
     console = Console()
     shown = "localhost" if host in ("127.0.0.1", "::1") else host
+    if study_file is not None:
+        console.print(f"[bold]activeintent study[/] from {study}: {len(configs)} conditions, {rounds} rounds; "
+                      f"sessions saved in {out}/")
+        for name, c in configs.items():
+            console.print(f"  {name}: {c.method} ({c.signal}), {c.design} "
+                          f"{c.intention or ''}, guess {c.show_estimate}")
+        console.print("Participants are assigned to the least-filled condition (counts in "
+                      f"{out}/assignment.json); a participant ID is "
+                      + ("required" if study_file.require_pid else "optional") + " (?pid=… or ?PROLIFIC_PID=…).")
+        console.print(f"Open http://{shown}:{port}/?pid=TEST — API schema at /openapi.json. Ctrl-C stops.")
+        if host not in ("127.0.0.1", "localhost", "::1"):
+            console.print(f"[yellow]Listening on {host}: anyone who can reach this address can take part.[/]")
+        uvicorn.run(app, host=host, port=port, log_level="warning")
+        return
+    signal, rule = config.signal, config.intention
+    method = config.method
     console.print(f"[bold]activeintent study[/]: {method} ({signal} signal), {rounds} rounds; "
                   f"sessions saved in {out}/")
     if rule is not None:
-        console.print(f"Design: assigned rule [bold]{rule.name}[/] — participants are told "
+        console.print(f"Design: assigned rule [bold]{rule}[/] — participants are told "
                       f"\"{config.intention_description}\"; success is scored against it.")
     else:
         console.print("Design: free rule — each participant picks their own rule; success is not scored "

@@ -23,13 +23,14 @@ from typing import Any
 from activeintent.records import dumps
 
 SESSION_COLUMNS = [
-    "session", "participant", "created", "ended", "status", "design", "intention", "intention_description",
+    "session", "participant", "pid", "study_id", "prolific_session_id", "condition", "consented",
+    "button_order", "created", "ended", "status", "design", "intention", "intention_description",
     "method", "signal", "show_estimate", "video_size", "seed", "rounds_planned", "rounds_answered",
     "signals_used", "answers", "answer_seconds_total", "session_seconds", "success", "success_basis",
-    "final_guess", "error", "questionnaire_final_attempt", "questionnaire_rule", "questionnaire_comments",
+    "final_guess", "final_scene", "final_scene_index", "final_scene_feasible", "error", "questionnaire_final_attempt", "questionnaire_rule", "questionnaire_comments",
     "questionnaire_submitted",
 ]
-ROUND_COLUMNS = ["answer", "stop_time", "response_s", "counted", "guess"]
+ROUND_COLUMNS = ["participant", "answer", "stop_time", "viewing", "after_end_presses", "response_s", "counted", "guess"]
 FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
 
 
@@ -99,6 +100,13 @@ def session_record(folder: Path) -> dict:
     server = [e for e in events if e.get("source") == "server"]
     presented = {e.get("round"): e.get("server_ts") for e in server if e.get("type") == "round_presented"}
     answered_at = {e.get("round"): e.get("server_ts") for e in server if e.get("type") == "answer"}
+    viewing = {e.get("round"): (e.get("client") or {}).get("viewing") for e in server if e.get("type") == "answer"}
+    # presses of Stop once the video had ended: refused by the page, or by the server
+    late: dict = {}
+    for e in events:
+        if e.get("type") == "stop_after_end":
+            late[e.get("round")] = late.get(e.get("round"), 0) + 1
+    participant = info.get("participant")
 
     rounds = []
     for r in _read_lines(folder / "rounds.jsonl"):
@@ -106,10 +114,15 @@ def session_record(folder: Path) -> dict:
         h = r.get("answer") if isinstance(r.get("answer"), dict) else {}
         t0, t1 = presented.get(n), answered_at.get(n)
         response = round(t1 - t0, 3) if isinstance(t0, int | float) and isinstance(t1, int | float) else None
+        label = answer_label(h)
         rounds.append({
             "round": n,
-            "answer": answer_label(h),
+            "participant": participant,  # on every row, so a round table stands on its own
+            "answer": label,
             "stop_time": h.get("stop_time"),
+            # a stop in the first viewing or in a replay after it (older sessions: first)
+            "viewing": (viewing.get(n) or "first") if label == "stop" else None,
+            "after_end_presses": late.get(n, 0),
             "response_s": response,
             "counted": r.get("counted"),
             "guess": r.get("z"),  # the learner's z when this round was asked (not necessarily shown)
@@ -121,7 +134,13 @@ def session_record(folder: Path) -> dict:
     size = study.get("video_size")
     return {
         "session": info.get("id") or folder.name,
-        "participant": info.get("participant"),
+        "participant": participant,
+        "pid": info.get("pid"),
+        "study_id": info.get("study_id"),
+        "prolific_session_id": info.get("prolific_session_id"),
+        "condition": info.get("condition", "single"),
+        "consented": _iso(info.get("consented")),
+        "button_order": " ".join(info.get("button_order") or []) or None,
         "created": _iso(created),
         "ended": _iso(ended),
         "status": _status(info, folder, server),
@@ -143,6 +162,9 @@ def session_record(folder: Path) -> dict:
         "success": summary.get("success") if scored else None,
         "success_basis": (summary.get("success_basis") or "assigned-rule") if scored and summary else "none",
         "final_guess": summary.get("final_z") or None,
+        "final_scene": ", ".join(info["final_scene"]) if isinstance(info.get("final_scene"), list) else None,
+        "final_scene_index": info.get("final_scene_index"),
+        "final_scene_feasible": info.get("final_scene_feasible"),
         "error": info.get("error") or summary.get("error"),
         "questionnaire_final_attempt": questionnaire.get("final_attempt"),
         "questionnaire_rule": questionnaire.get("rule"),

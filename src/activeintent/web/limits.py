@@ -220,7 +220,10 @@ class SessionLimits:
         self._started: dict[str, deque[float]] = {}  # client -> clock times of its recent sessions
 
     # -- admission ----------------------------------------------------------------------------
-    def create(self, client: str, participant: str | None = None, seed: int | None = None) -> WebSession:
+    def create(self, client: str, participant: str | None = None, seed: int | None = None,
+               **enrol: Any) -> WebSession:
+        """A new session for ``client``; ``enrol``: the URL's IDs and the consent (see
+        :meth:`SessionManager.create`)."""
         cancelled = self.expire_idle()
         deadline = time.monotonic() + self.limits.settle_seconds
         for s in cancelled:  # their slots are free once their episodes have stopped
@@ -254,7 +257,7 @@ class SessionLimits:
                     f"{len(live)} sessions are in progress (limit {self.max_sessions}); try again later",
                     headers={"Retry-After": retry},
                 )
-            session = self.manager.create(participant=participant, seed=seed)
+            session = self.manager.create(participant=participant, seed=seed, **enrol)
             self._owner[session.id] = client
             self._seen[session.id] = now
             started.append(now)

@@ -36,6 +36,7 @@ from activeintent.web.session import (
     StudyConfig,
     WebSession,
 )
+from activeintent.web.study import PID_RULE, URL_PARAMETERS, StudyFile, check_pid
 
 STATIC = Path(__file__).parent / "static"
 MAX_FILE_NAME = 64  # longer than any video name the server writes
@@ -57,9 +58,23 @@ class _Body(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
 
+def _url_id(what: str):
+    return Field(None, description=f"{what}, from the study link; {PID_RULE}")
+
+
 class NewSession(_Body):
-    participant: str | None = Field(None, max_length=100, description="optional participant code")
+    participant: str | None = Field(None, max_length=100, description="optional participant code (typed)")
     seed: int | None = Field(None, ge=0, le=2**31 - 1, description="seed of the episode (default: next)")
+    pid: str | None = _url_id("the participant ID (?pid= or PROLIFIC_PID=)")
+    study_id: str | None = _url_id("STUDY_ID")
+    prolific_session_id: str | None = _url_id("SESSION_ID")
+    consent: bool | None = Field(None, description="the participant agreed to the study's consent text")
+
+    @field_validator("pid", "study_id", "prolific_session_id")
+    @classmethod
+    def _url_ids(cls, v: str | None, info) -> str | None:
+        what = {"pid": "participant ID", "study_id": "STUDY_ID", "prolific_session_id": "SESSION_ID"}[info.field_name]
+        return None if v is None else check_pid(v, what)
 
     @field_validator("participant")
     @classmethod
@@ -83,6 +98,16 @@ class StopAnswer(_Body):
     time: float | None = Field(
         None, allow_inf_nan=False, description="for action 'stop': the video's currentTime in seconds"
     )
+    viewing: Literal["first", "replay"] = Field(
+        "first", description="for action 'stop': during the first viewing or a replay after it")
+    client_ts: float | None = _client_ts()
+
+
+class VideoReport(_Body):
+    round: int = Field(ge=1, le=MAX_ROUND, description="the round on screen")
+    event: Literal["ready", "ended", "replay"] = Field(
+        description="ready: the first viewing starts; ended: it played to the end; replay: a replay starts")
+    media_time: float | None = Field(None, ge=0, le=1e5, allow_inf_nan=False)
     client_ts: float | None = _client_ts()
 
 
@@ -163,7 +188,9 @@ def _feedback_maker(session: WebSession, body: PreferenceAnswer | StopAnswer):
         if body.action == "stop":
             if body.time is None:
                 raise AnswerRejected("action 'stop' needs 'time': the video time in seconds", status=422)
-            return stop_answer(q.trajectories[0], body.time, session.config.fps)
+            h = stop_answer(q.trajectories[0], body.time, session.config.fps)  # outside the video: 422
+            _check_stop(session, q, body)
+            return h
         if body.time is not None:
             raise AnswerRejected(f"action '{body.action}' takes no 'time'", status=422)
         if body.action == "new_scene":
@@ -173,18 +200,38 @@ def _feedback_maker(session: WebSession, body: PreferenceAnswer | StopAnswer):
     return make
 
 
+def _check_stop(session: WebSession, q: Question, body: StopAnswer) -> None:
+    """A stop is a moment *inside* the video: not at or after its end, and not in the first
+    viewing once the page has reported that viewing ended (a late key press)."""
+    length = q.presented[0].duration if q.presented else None
+    if length is not None and body.time is not None and body.time >= length - 1e-9:
+        raise ApiError(422, "after_video_end", f"stop time {body.time:.3f} s is at or after the end of the video "
+                       f"({length:.3f} s): the video had ended, so this is not a stop; answer looks_good or "
+                       "stop during a replay")
+    seen = session.viewing(q.round)
+    if body.viewing == "first" and seen["ended"] is not None:
+        raise ApiError(422, "after_video_end", "the first viewing of this video had ended before this stop; "
+                       "stop during a replay (viewing: 'replay') or answer looks_good")
+    if body.viewing == "replay" and not seen["replays"]:
+        raise ApiError(422, "invalid_answer", "viewing 'replay' but no replay of this round was started")
+
+
 def create_app(
     config: StudyConfig,
     builder: EpisodeBuilder | None = None,
     limits: Limits | None = None,
     clock: Callable[[], float] = time.monotonic,
+    study: StudyFile | None = None,
+    conditions: dict[str, tuple[StudyConfig, EpisodeBuilder]] | None = None,
 ) -> FastAPI:
     """The app for one study. ``builder`` builds each session's episode; by default
     :func:`activeintent.runner.build_episode` with the study's options. ``limits`` are the
     per-client, size and quota limits (see :mod:`activeintent.web.limits`); ``clock`` is what
-    the idle timeout and rate limits count seconds with."""
+    the idle timeout and rate limits count seconds with. ``study`` (a study file) and its
+    ``conditions`` (name → StudyConfig and builder) replace the single ``config`` for the
+    sessions; ``config`` still gives the folder and the server's limits."""
     limits = limits or Limits()
-    manager = SessionManager(config, builder or runner_builder(config))
+    manager = SessionManager(config, builder or runner_builder(config), conditions=conditions, study=study)
     guard = SessionLimits(manager, limits, clock=clock)
 
     @asynccontextmanager
@@ -218,8 +265,17 @@ def create_app(
 
     @app.get("/api/config", summary="The study's configuration (what every session runs)")
     def get_config() -> dict:
+        if study is not None:
+            # conditions differ per participant and are not for participants to read
+            return {"study": True, "consent": study.consent, "require_pid": study.require_pid,
+                    "rounds": next(iter(manager.conditions.values()))[0].rounds,
+                    "url_parameters": list(URL_PARAMETERS)}
         assigned = config.design == "assigned-rule"
         return {
+            "study": False,
+            "consent": None,
+            "require_pid": False,
+            "url_parameters": list(URL_PARAMETERS),
             "method": config.method,
             "signal": config.signal,
             "rounds": config.rounds,
@@ -237,7 +293,9 @@ def create_app(
     def create_session(request: Request, body: NewSession | None = None) -> dict:
         body = body or NewSession()
         client = request.client.host if request.client else "unknown"
-        session = guard.create(client, participant=body.participant, seed=body.seed)
+        session = guard.create(client, participant=body.participant, seed=body.seed, pid=body.pid,
+                               study_id=body.study_id, prolific_session_id=body.prolific_session_id,
+                               consent=body.consent)
         return session.state()
 
     @app.get("/api/sessions/{sid}", summary="Session state: round i of K, the question, z, status")
@@ -247,9 +305,15 @@ def create_app(
     @app.post("/api/sessions/{sid}/answer", summary="Answer the waiting round (names the round)")
     def post_answer(sid: str, body: Answer) -> dict:
         session = session_or_404(sid)
-        client = {"client_ts": body.client_ts, **({"time": body.time} if isinstance(body, StopAnswer) else {})}
+        client = {"client_ts": body.client_ts,
+                  **({"time": body.time, "viewing": body.viewing} if isinstance(body, StopAnswer) else {})}
         h = session.answer(body.round, _feedback_maker(session, body), client=client)
         return {"accepted": True, "round": body.round, "answer": h.model_dump(mode="json")}
+
+    @app.post("/api/sessions/{sid}/video", summary="The round's video: ready, ended or a replay starts")
+    def post_video(sid: str, body: VideoReport) -> dict:
+        session = session_or_404(sid)
+        return {"round": body.round, "viewing": session.video_event(body.round, body.event, body.media_time)}
 
     @app.post("/api/sessions/{sid}/events", summary="Append raw UI events (client timestamps kept)")
     def post_events(sid: str, body: EventBatch) -> dict:
@@ -327,10 +391,14 @@ def runner_builder(config: StudyConfig, **options: Any) -> EpisodeBuilder:
         base["intention_file"] = config.intention_file
     elif config.intention is not None:
         base["intention"] = config.intention
+    # The final attempt is what participants judge: with an assigned rule, on a table where
+    # that rule can be shown at all; a free rule is unknown, so the first table.
+    show = "first-feasible" if config.design == "assigned-rule" else "first"
 
     def build(seed: int, out_dir: Path, user, observers):
         from activeintent.runner import RunOptions, build_episode
 
-        return build_episode(RunOptions(**base, seed=seed), out_dir, user=user, observers=observers)
+        return build_episode(RunOptions(**base, seed=seed), out_dir, user=user, observers=observers,
+                             show_final=show)
 
     return build

@@ -116,6 +116,30 @@ class RoundInfo(BaseModel):
 
 
 CONFIDENCE_BASIS = "the learner's posterior probability of this guess among its hypotheses"
+EXPECTED_SUCCESS_BASIS = ("the learner's expected probability that this attempt does what you want "
+                          "(its belief over rules, on this table)")
+
+
+class Enrolment(BaseModel):
+    """How a session came to be: its condition (study file) and who it is, from the URL."""
+
+    condition: str = Field("single", description="the study file's condition ('single': serve without one)")
+    slot: int = Field(0, description="participants of this condition before this one")
+    number: int = Field(0, description="participants of the study before this one")
+    again: bool = Field(False, description="a participant ID seen before, given its earlier condition")
+    pid: str | None = Field(None, description="the participant ID from the URL (?pid= or PROLIFIC_PID=)")
+    study_id: str | None = Field(None, description="STUDY_ID from the URL")
+    prolific_session_id: str | None = Field(None, description="SESSION_ID from the URL")
+    consented: float | None = Field(None, description="server time the consent was given (None: no consent asked)")
+    button_order: list[str] = Field(default_factory=list, description="the answer buttons, in the order shown")
+
+
+class Completion(BaseModel):
+    """What a participant gets once the questionnaire is sent (from the study file)."""
+
+    code: str | None = None
+    redirect_url: str | None = None
+    redirect_after_s: float | None = None
 
 
 class Guess(BaseModel):
@@ -124,6 +148,8 @@ class Guess(BaseModel):
     z: str
     confidence: float | None = Field(None, ge=0, le=1, description="the learner's belief in z, where it has one")
     basis: str | None = Field(None, description="what the confidence is")
+    kind: Literal["posterior", "expected_success"] | None = Field(
+        None, description="posterior: the belief in z; expected_success: the final attempt's expected success")
     answers: int = Field(description="answers of this participant the guess is based on")
 
 
@@ -140,14 +166,23 @@ def _belief_of(top: Any, z: str) -> float | None:
 def guess_of(estimate: Any, answers: int, belief_top: Any = None) -> Guess:
     """The guess of an :class:`~activeintent.learners.base.Estimate`. Bayesian learners say how
     much they believe z (``why.belief_before``, or the last belief snapshot of the round records
-    for the final answer); other learners give no confidence."""
+    for the final answer) or, for the final answer, how likely its attempt is to succeed
+    (``why.expected_success``); other learners give no confidence."""
     why = getattr(estimate, "why", None) or {}
-    before = why.get("belief_before") if isinstance(why, dict) else None
+    why = why if isinstance(why, dict) else {}
+    before = why.get("belief_before")
     p = _belief_of(before.get("top") if isinstance(before, dict) else None, estimate.z)
+    basis = CONFIDENCE_BASIS
     if p is None:
         p = _belief_of(belief_top, estimate.z)
+    expected = why.get("expected_success")
+    if p is None and isinstance(expected, int | float) and not isinstance(expected, bool):
+        # the final answer names z by description while the snapshots name rules: its own
+        # expected success is the confidence it does report
+        p, basis = float(expected), EXPECTED_SUCCESS_BASIS
     return Guess(z=estimate.z, confidence=None if p is None else round(min(max(p, 0.0), 1.0), 4),
-                 basis=None if p is None else CONFIDENCE_BASIS, answers=answers)
+                 basis=None if p is None else basis, answers=answers,
+                 kind=None if p is None else "posterior" if basis == CONFIDENCE_BASIS else "expected_success")
 
 
 def scene_legend(objects: list[str]) -> list[dict]:
@@ -208,9 +243,16 @@ class StudyRecorder(EpisodeRecorder):
 
 
 class WebSession:
-    def __init__(self, sid: str, seed: int, config: StudyConfig, builder: EpisodeBuilder, participant: str | None):
+    def __init__(self, sid: str, seed: int, config: StudyConfig, builder: EpisodeBuilder, participant: str | None,
+                 enrolment: Enrolment | None = None, completion: Completion | None = None):
         self.id, self.seed, self.config, self.builder = sid, seed, config, builder
         self.participant = participant
+        self.enrolment = enrolment or Enrolment()
+        self.completion = completion
+        # per round: when the first viewing was started (Ready) and ended, and replays after it
+        self._viewing: dict[int, dict] = {}
+        self.final_scene_index: int | None = None
+        self.final_scene_feasible: bool | None = None
         self.dir = (config.out_dir / sid).resolve()
         self.dir.mkdir(parents=True, exist_ok=False)
         self.created = time.time()
@@ -242,9 +284,15 @@ class WebSession:
             "id": self.id,
             "seed": self.seed,
             "participant": self.participant,
+            **self.enrolment.model_dump(),
             "created": self.created,
             "design": self.config.design,
             "show_estimate": self.config.show_estimate,
+            # the final attempt's table: its index among the test scenes, and whether the
+            # assigned rule can be shown on it at all (None: free rule, nothing is known)
+            "final_scene": self.final_scene,
+            "final_scene_index": self.final_scene_index,
+            "final_scene_feasible": self.final_scene_feasible,
             "status": self.status,
             "ended": self.ended,
             "error": self.error,
@@ -254,7 +302,8 @@ class WebSession:
     def start(self) -> None:
         self._write_session_file()
         self.log_server("session_created", seed=self.seed, participant=self.participant,
-                        design=self.config.design, show_estimate=self.config.show_estimate)
+                        design=self.config.design, show_estimate=self.config.show_estimate,
+                        **self.enrolment.model_dump())
         self._thread.start()
 
     def _run(self) -> None:
@@ -356,11 +405,20 @@ class WebSession:
             self.phase = "final"
 
     def tested(self, k: int, index: int, scene: Any, estimate: Any, traj: Any) -> None:
-        if index == 0:  # the final attempt shown to the participant: the first test scene
-            self._final_trajectory = traj
-            self.final_scene = list(scene.objects)
-            self.estimate = estimate.z
-            self.final_guess = guess_of(estimate, answers=len(self.rounds), belief_top=self._belief_top)
+        if index == 0 and self.final_scene_index is None:  # episodes without final_shown: the first test scene
+            self._set_final(index, scene, estimate, traj, None)
+
+    def final_shown(self, index: int, scene: Any, estimate: Any, traj: Any, feasible: bool) -> None:
+        """The final attempt shown to the participant (see ``Episode.show_final``)."""
+        self._set_final(index, scene, estimate, traj, feasible if self.config.design == "assigned-rule" else None)
+        self.log_server("final_attempt", scene=self.final_scene, index=index, feasible=self.final_scene_feasible)
+
+    def _set_final(self, index: int, scene: Any, estimate: Any, traj: Any, feasible: bool | None) -> None:
+        self._final_trajectory = traj
+        self.final_scene = list(scene.objects)
+        self.final_scene_index, self.final_scene_feasible = index, feasible
+        self.estimate = estimate.z
+        self.final_guess = guess_of(estimate, answers=len(self.rounds), belief_top=self._belief_top)
 
     @property
     def signals_used(self) -> int:
@@ -370,9 +428,38 @@ class WebSession:
     def answer(self, round: int, make: Callable[[Question], Any], client: dict | None = None):
         if not self.active:
             raise AnswerRejected(f"session {self.id} is {self.status}; it takes no more answers", status=409)
-        h = self.user.answer(round, make)
+        try:
+            h = self.user.answer(round, make)
+        except ApiError as err:
+            # a stop after the video's end is kept on record, as refused (other bad answers
+            # change nothing saved)
+            if err.code == "after_video_end":
+                self.log_server("stop_after_end", round=round, reason=err.message, client=client)
+            raise
         self.log_server("answer", round=round, answer=h.model_dump(mode="json"), client=client)
         return h
+
+    # -- what the participant did with the round's video (request threads) --------------------
+    def viewing(self, round: int) -> dict:
+        return dict(self._viewing.get(round) or {"ready": None, "ended": None, "replays": 0})
+
+    def video_event(self, round: int, event: str, media_time: float | None = None) -> dict:
+        """``ready`` (the first viewing starts), ``ended`` (it has played to its end) or
+        ``replay`` (a replay starts; only after the end) for the round on screen."""
+        q = self.user.question
+        if q is None or q.round != round or self.status != "waiting-for-answer":
+            raise ApiError(409, "conflict", f"round {round} is not on screen in session {self.id}")
+        with self._events_lock:
+            v = self._viewing.setdefault(round, {"ready": None, "ended": None, "replays": 0})
+            if event == "replay" and v["ended"] is None:
+                raise ApiError(409, "conflict", "a replay comes after the first viewing has ended")
+            if event in ("ready", "ended") and v[event] is None:
+                v[event] = time.time()
+            if event == "replay":
+                v["replays"] += 1
+            out = dict(v)
+        self.log_server(f"video_{event}", round=round, media_time=media_time, replays=out["replays"])
+        return out
 
     def _guess_visible(self, guess: Guess | None) -> bool:
         # never the learner's prior: a guess is shown only once it rests on an answer
@@ -397,6 +484,7 @@ class WebSession:
                 "scene": objects,
                 "legend": scene_legend(objects),
                 "videos": [v.model_dump() for v in (q.presented or [])],
+                "viewing": self.viewing(q.round),
             }
         guess = self.visible_guess()
         finished = status == "finished"
@@ -416,7 +504,10 @@ class WebSession:
             # the round the participant is on, as "round i of K"
             "progress": min(self.signals_used + 1, self.config.rounds),
             "question": question,
+            "button_order": self.enrolment.button_order,
             "estimate": guess.model_dump() if guess else None,
+            # the completion code and redirect: once the questionnaire is in
+            "completion": self.completion.model_dump() if self.completion and self.questionnaire else None,
             "final_video": self.final_video.model_dump() if self.final_video and finished else None,
             "final_legend": scene_legend(self.final_scene) if self.final_scene and finished else None,
             "success": self.result.get("success") if self.result else None,
@@ -449,6 +540,7 @@ class WebSession:
             record = {
                 "session": self.id,
                 "participant": self.participant,
+                "condition": self.enrolment.condition,
                 "design": self.config.design,
                 "intention": self.config.intention if self.config.design == "assigned-rule" else None,
                 "session_status": self.status,
@@ -485,15 +577,36 @@ class WebSession:
 
 
 class SessionManager:
-    """All sessions of one server; each isolated in its own folder and thread."""
+    """All sessions of one server; each isolated in its own folder and thread.
 
-    def __init__(self, config: StudyConfig, builder: EpisodeBuilder):
-        self.config, self.builder = config, builder
+    ``conditions`` (a study file's, by name: their StudyConfig and builder) are assigned to new
+    participants in a balanced way (:class:`activeintent.web.study.Assigner`, persisted in
+    ``OUT/assignment.json``); without them every session runs ``config`` as condition
+    ``single``. ``study`` is the study file (consent, completion code, …) or None."""
+
+    def __init__(self, config: StudyConfig, builder: EpisodeBuilder,
+                 conditions: dict[str, tuple[StudyConfig, EpisodeBuilder]] | None = None, study: Any = None):
+        from activeintent.web.study import Assigner
+
+        self.config, self.builder, self.study = config, builder, study
+        self.conditions = conditions or {"single": (config, builder)}
         self._sessions: dict[str, WebSession] = {}
         self._lock = threading.Lock()
-        self._count = 0
+        self.assigner = Assigner(list(self.conditions), seed=study.assignment_seed if study else 0,
+                                 path=config.out_dir / "assignment.json")
 
-    def create(self, participant: str | None = None, seed: int | None = None) -> WebSession:
+    def create(self, participant: str | None = None, seed: int | None = None, pid: str | None = None,
+               study_id: str | None = None, prolific_session_id: str | None = None,
+               consent: bool | None = None) -> WebSession:
+        from activeintent.web.study import button_order
+
+        study = self.study
+        if study is not None and study.require_pid and pid is None:
+            raise ApiError(422, "pid_required", "this study needs a participant ID from its link "
+                           "(?pid=… or ?PROLIFIC_PID=…); please open the link you were given")
+        if study is not None and consent is not True:
+            raise ApiError(422, "consent_required", "the session starts only after the participant "
+                           "agrees to the consent text (consent: true)")
         with self._lock:
             active = sum(1 for s in self._sessions.values() if s.active)
             if active >= self.config.max_sessions:
@@ -501,13 +614,21 @@ class SessionManager:
                     f"{active} sessions are in progress (limit {self.config.max_sessions}); try again later",
                     status=503,
                 )
+            got = self.assigner.assign(pid)
+            config, builder = self.conditions[got.condition]
             if seed is None:
-                seed = self.config.seed + self._count
-            self._count += 1
+                seed = config.seed + got.number  # persisted: a restarted server does not repeat seeds
             sid = secrets.token_hex(8)
             while sid in self._sessions or (self.config.out_dir / sid).exists():
                 sid = secrets.token_hex(8)
-            session = WebSession(sid, seed, self.config, self.builder, participant)
+            enrolment = Enrolment(
+                **got.model_dump(), pid=pid, study_id=study_id, prolific_session_id=prolific_session_id,
+                consented=time.time() if consent else None,
+                button_order=button_order(config.signal, got.slot, study.counterbalance_buttons if study else True))
+            completion = Completion(code=study.completion_code, redirect_url=study.redirect_url,
+                                    redirect_after_s=study.redirect_after_s) if study else None
+            session = WebSession(sid, seed, config, builder, participant if pid is None else pid,
+                                 enrolment=enrolment, completion=completion)
             self._sessions[sid] = session
         session.start()
         return session

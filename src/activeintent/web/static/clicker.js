@@ -1,5 +1,8 @@
-// Clicker page: one video τ plays once; Stop records the media time of the frame on screen
-// (the server maps it to the trajectory tick); Looks good once it has ended; New scene.
+// Clicker page: one video τ. Behind a ready gate until the participant presses Ready; then it
+// plays once and Stop records the media time of the frame on screen (the server maps it to
+// the trajectory tick). When it ends, Stop is off: a late press is logged as "after end" and
+// never sent as a stop. Looks good once it has ended; Replay after the end, and a stop during a
+// replay is sent flagged as such (viewing: "replay"). New scene at any time.
 // After a stop the video stays paused on the frame the participant stopped at, with a marker,
 // until the next round is ready.
 "use strict";
@@ -7,19 +10,31 @@
 (() => {
   const video = document.getElementById("video");
   const card = document.getElementById("video-card");
+  const stage = document.getElementById("stage");
+  const question = document.getElementById("question");
   const badge = document.getElementById("stop-badge");
   const timeline = document.getElementById("timeline");
   const stopBtn = document.getElementById("stop");
   const goodBtn = document.getElementById("good");
   const newBtn = document.getElementById("new-scene");
   const playBtn = document.getElementById("play");
+  const replayBtn = document.getElementById("replay");
   const status = document.getElementById("status");
   let round = null; // the round on screen and not yet answered
   let shownRound = null;
   let stoppedAt = null; // media time of the accepted stop, while its frame stays on screen
+  // gate → first → ended (→ replay → ended …); the stop button works in first and replay only
+  let phase = "gate";
+  let endedAt = null; // client time the first viewing ended
 
   Study.watchVideo(video, "robot", () => shownRound);
   Study.setupLegend(document.getElementById("legend-toggle"), document.getElementById("legend"), () => shownRound);
+
+  function setPhase(p) {
+    phase = p;
+    question.dataset.phase = p;
+    setEnabled(round !== null);
+  }
 
   function fraction(t) {
     const d = video.duration;
@@ -29,11 +44,35 @@
     if (stoppedAt === null) timeline.querySelector(".played").style.width = `${100 * fraction(video.currentTime)}%`;
   });
   video.addEventListener("ended", () => {
-    if (round !== null) goodBtn.disabled = false;
+    if (round === null || (phase !== "first" && phase !== "replay")) return;
+    const first = phase === "first";
+    if (first) endedAt = Study.now();
+    setPhase("ended");
+    replayBtn.classList.remove("hidden");
+    // the server refuses first-viewing stops from now on (its own check of late presses)
+    if (first) Study.reportVideo(round, "ended", video.currentTime).catch(() => {});
   });
   playBtn.addEventListener("click", () => {
     Study.log("play_clicked", {}, shownRound);
     playBtn.classList.add("hidden");
+    video.play().catch(() => {});
+  });
+  replayBtn.addEventListener("click", async () => {
+    if (round === null || phase !== "ended") return;
+    replayBtn.disabled = true;
+    try {
+      await Study.reportVideo(round, "replay", 0); // before any stop of the replay can be sent
+    } catch (err) {
+      status.textContent = `Replay not possible: ${err.message}`;
+      replayBtn.disabled = false;
+      return;
+    }
+    replayBtn.disabled = false;
+    replayBtn.classList.add("hidden");
+    Study.log("replay", { video: "robot" }, shownRound);
+    status.textContent = "Replay: you may still stop the robot.";
+    video.currentTime = 0;
+    setPhase("replay");
     video.play().catch(() => {});
   });
 
@@ -57,26 +96,37 @@
   }
 
   function setEnabled(on) {
-    stopBtn.disabled = !on;
+    stopBtn.disabled = !(on && (phase === "first" || phase === "replay"));
     newBtn.disabled = !on;
-    goodBtn.disabled = !(on && video.ended);
+    goodBtn.disabled = !(on && phase === "ended");
+  }
+
+  // A stop once the video has ended is no stop: say so, keep it in the log, send nothing.
+  function lateStop(via) {
+    Study.log("stop_after_end", { via, time: video.currentTime, duration: video.duration,
+      since_end_s: endedAt === null ? null : Study.now() - endedAt }, round);
+    status.textContent = "The video has ended, so Stop no longer counts: choose Looks good, or Replay to watch it again.";
   }
 
   async function send(action, via) {
     if (round === null) return;
+    if (action === "stop" && phase === "ended") return lateStop(via);
+    if (action === "stop" && phase !== "first" && phase !== "replay") return;
     const answering = round;
     round = null;
     const body = { kind: "stop", round: answering, action, client_ts: Study.now() };
     if (action === "stop") {
       video.pause(); // freeze the frame the participant reacted to
       body.time = video.currentTime;
+      body.viewing = phase === "replay" ? "replay" : "first";
     }
     setEnabled(false);
-    Study.log(action, { via, time: video.currentTime, duration: video.duration }, answering);
+    Study.log(action, { via, time: video.currentTime, duration: video.duration, viewing: body.viewing ?? null }, answering);
     status.textContent = action === "stop" ? `Stopped at ${video.currentTime.toFixed(2)} s. Sending…` : "Sending…";
     try {
       await Study.api("POST", `/api/sessions/${Study.sessionId}/answer`, body);
       Study.log("answer_accepted", { action, time: body.time ?? null }, answering);
+      replayBtn.classList.add("hidden");
       if (action === "stop") {
         markStop(body.time);
         status.textContent = `You stopped the robot at ${body.time.toFixed(2)} s: the frame stays above.`;
@@ -86,7 +136,7 @@
         Study.setWaiting(true, "Thank you. The robot is thinking about what you showed it…");
       }
     } catch (err) {
-      Study.log("answer_rejected", { action, error: err.message }, answering);
+      Study.log("answer_rejected", { action, error: err.message, code: err.code ?? null }, answering);
       status.textContent = `Not accepted: ${err.message}`;
       round = answering;
       setEnabled(true);
@@ -104,7 +154,7 @@
     if (!action) return;
     if (round === null && e.target && e.target.tagName === "BUTTON") return; // e.g. Continue, Show colour names
     e.preventDefault(); // space must not scroll or press a focused button
-    Study.log("key", { key: k }, round);
+    Study.log("key", { key: k, phase }, round);
     if (action === "looks_good" && goodBtn.disabled) return;
     send(action, "key");
   });
@@ -115,16 +165,23 @@
     Study.fillLegend(document.getElementById("legend-list"), q.legend);
     Study.describeVideo(video, document.getElementById("caption"), "The robot tidying this table", q.legend, v.duration);
     playBtn.classList.add("hidden");
+    replayBtn.classList.add("hidden");
     video.src = v.url;
     video.load();
     round = q.round;
-    setEnabled(true);
+    endedAt = null;
+    stage.classList.add("gated");
+    setPhase("gate");
     Study.setWaiting(false);
-    document.getElementById("question").dataset.round = String(q.round);
+    question.dataset.round = String(q.round);
     status.textContent = "";
     Study.log("round_shown", { video: v.url, duration: v.duration, fps: v.fps }, q.round);
-    video.play().catch((err) => {
-      if (err.name === "NotAllowedError") playBtn.classList.remove("hidden"); // autoplay blocked
+    Study.readyGate(document.getElementById("gate"), q.round, () => {
+      stage.classList.remove("gated");
+      setPhase("first");
+      video.play().catch((err) => {
+        if (err.name === "NotAllowedError") playBtn.classList.remove("hidden"); // autoplay blocked
+      });
     });
   }
 
@@ -134,6 +191,7 @@
     if (Study.routeFinished(s)) return;
     Study.setProgress(s);
     Study.setEstimate(s);
+    Study.orderButtons(document.getElementById("answers"), "data-action", s.button_order);
     if (s.status === "waiting-for-answer" && s.question && s.question.round !== shownRound) {
       shownRound = s.question.round;
       Study.betweenRounds(s, () => show(s.question));

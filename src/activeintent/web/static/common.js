@@ -104,7 +104,10 @@ const Study = (() => {
     if (!conf) return;
     if (est && typeof est.confidence === "number") {
       const pct = Math.round(100 * est.confidence);
-      conf.textContent = `The robot is ${pct}% sure of this guess (after ${est.answers} answer${est.answers === 1 ? "" : "s"}).`;
+      const after = `after ${est.answers} answer${est.answers === 1 ? "" : "s"}`;
+      conf.textContent = est.kind === "expected_success"
+        ? `The robot expects this attempt to do what you want with ${pct}% probability (${after}).`
+        : `The robot is ${pct}% sure of this guess (${after}).`;
       conf.title = est.basis || "";
     } else {
       conf.textContent = est ? "This robot does not say how sure it is." : "";
@@ -222,6 +225,47 @@ const Study = (() => {
     return false;
   }
 
+  // The ready gate before a video: nothing plays until the participant presses Ready (or Enter).
+  // onReady runs once; the gate logs how it was passed and tells the server (video "ready").
+  function readyGate(gate, round, onReady) {
+    const button = gate.querySelector("button");
+    gate.classList.remove("hidden");
+    button.disabled = false;
+    button.focus();
+    const go = (via) => {
+      button.onclick = null;
+      document.removeEventListener("keydown", onKey, true);
+      button.disabled = true;
+      gate.classList.add("hidden");
+      log("ready", { via }, round);
+      if (round !== null) reportVideo(round, "ready", 0);
+      onReady();
+    };
+    const onKey = (e) => {
+      if (e.key !== "Enter" || e.repeat) return;
+      e.preventDefault();
+      e.stopImmediatePropagation(); // not also an answer key
+      go("key");
+    };
+    button.onclick = () => go("click");
+    document.addEventListener("keydown", onKey, true);
+  }
+
+  // What happened to the round's video, for the server's own check of stop answers.
+  function reportVideo(round, event, mediaTime) {
+    const body = { round, event, client_ts: now() };
+    if (typeof mediaTime === "number" && Number.isFinite(mediaTime)) body.media_time = mediaTime;
+    return api("POST", `/api/sessions/${sessionId}/video`, body);
+  }
+
+  // The answer buttons in this participant's order (counterbalanced, see session.button_order).
+  function orderButtons(container, attr, order) {
+    for (const key of order || []) {
+      const b = container.querySelector(`button[${attr}="${key}"]`);
+      if (b) container.append(b);
+    }
+  }
+
   // Keys typed into a form field are not shortcuts.
   function isTyping(e) {
     const t = e.target;
@@ -231,5 +275,6 @@ const Study = (() => {
   return {
     sessionId, now, api, log, flush, goTo, poll, setProgress, fillGuess, setEstimate, setWaiting, showFatal,
     watchVideo, routeFinished, isTyping, setupLegend, fillLegend, describeVideo, betweenRounds,
+    readyGate, reportVideo, orderButtons,
   };
 })();

@@ -13,11 +13,13 @@
   Study.watchVideo(video, "final", () => null);
   Study.setupLegend(document.getElementById("legend-toggle"), document.getElementById("legend"), () => null);
   document.getElementById("replay").addEventListener("click", () => {
+    if (document.getElementById("stage").classList.contains("gated")) return;
     Study.log("replay", { video: "final" });
     video.currentTime = 0;
     video.play().catch(() => {});
   });
 
+  let redirecting = false;
   function finish(s) {
     form.classList.add("hidden");
     document.getElementById("finished").classList.remove("hidden");
@@ -25,6 +27,35 @@
     const guess = s && s.estimate;
     box.classList.toggle("hidden", !guess);
     Study.fillGuess(box, guess || null);
+    if (s && s.completion) showCompletion(s.completion);
+    else if (s && !s.questionnaire.submitted) refresh(); // the code comes with the state once the answers are in
+  }
+
+  async function refresh() {
+    try {
+      const s = await Study.api("GET", `/api/sessions/${Study.sessionId}`);
+      if (s.completion) showCompletion(s.completion);
+    } catch (_) { /* the poll reports lost contact */ }
+  }
+
+  // The study file's completion code and redirect (e.g. back to Prolific).
+  function showCompletion(c) {
+    const box = document.getElementById("completion");
+    if (!c.code && !c.redirect_url) return;
+    box.classList.remove("hidden");
+    document.getElementById("completion-code").textContent = c.code || "";
+    box.querySelector("p").classList.toggle("hidden", !c.code);
+    if (!c.redirect_url) return;
+    const link = document.getElementById("redirect-link");
+    link.href = c.redirect_url;
+    link.classList.remove("hidden");
+    if (typeof c.redirect_after_s === "number" && !redirecting) {
+      redirecting = true;
+      document.getElementById("redirect-note").textContent = `(you are taken there in ${c.redirect_after_s} s)`;
+      Study.log("redirect_scheduled", { after_s: c.redirect_after_s });
+      Study.flush();
+      setTimeout(() => { location.href = c.redirect_url; }, 1000 * c.redirect_after_s);
+    }
   }
 
   form.addEventListener("submit", async (e) => {
@@ -89,7 +120,11 @@
       Study.describeVideo(video, document.getElementById("final-caption"),
         "The robot's final attempt on a new table", s.final_legend, s.final_video.duration);
       video.src = s.final_video.url;
-      video.play().catch(() => {});
+      document.getElementById("stage").classList.add("gated");
+      Study.readyGate(document.getElementById("gate"), null, () => {
+        document.getElementById("stage").classList.remove("gated");
+        video.play().catch(() => {});
+      });
     } else {
       document.getElementById("final-card").classList.add("hidden");
     }

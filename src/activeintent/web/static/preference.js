@@ -8,12 +8,14 @@
   const keys = { a: "A", b: "B", c: "cant_choose", n: "new_scene" };
   let round = null; // the round on screen and not yet answered
   let shownRound = null;
+  const videosBox = document.getElementById("videos");
 
   Study.watchVideo(videos.A, "A", () => shownRound);
   Study.watchVideo(videos.B, "B", () => shownRound);
   Study.setupLegend(document.getElementById("legend-toggle"), document.getElementById("legend"), () => shownRound);
 
   function replay(which) {
+    if (videosBox.classList.contains("gated")) return; // nothing plays before Ready
     Study.log("replay", { video: which }, shownRound);
     for (const v of which === "both" ? [videos.A, videos.B] : [videos[which]]) {
       v.currentTime = 0;
@@ -62,6 +64,8 @@
     answer(choice, "key");
   });
 
+  // The videos load behind the ready gate and play, with the answers enabled, once the
+  // participant says they are ready.
   function show(q) {
     Study.fillLegend(document.getElementById("legend-list"), q.legend);
     for (const v of q.videos) {
@@ -71,13 +75,22 @@
         `Video ${v.label}: the robot's ${which} way of tidying this table`, q.legend, v.duration);
       el.src = v.url;
       el.load();
-      el.play().catch(() => {}); // muted autoplay is allowed; replay buttons otherwise
     }
-    round = q.round;
-    setEnabled(true);
+    round = null;
+    setEnabled(false);
+    videosBox.classList.add("gated");
     Study.setWaiting(false);
-    document.getElementById("question").dataset.round = String(q.round);
+    const question = document.getElementById("question");
+    question.dataset.round = String(q.round);
+    question.dataset.phase = "gate";
     Study.log("round_shown", { videos: q.videos.map((v) => v.url) }, q.round);
+    Study.readyGate(document.getElementById("gate"), q.round, () => {
+      videosBox.classList.remove("gated");
+      question.dataset.phase = "playing";
+      for (const el of Object.values(videos)) el.play().catch(() => {});
+      round = q.round;
+      setEnabled(true);
+    });
   }
 
   Study.log("page_load", { page: "preference" });
@@ -86,6 +99,7 @@
     if (Study.routeFinished(s)) return;
     Study.setProgress(s);
     Study.setEstimate(s);
+    Study.orderButtons(document.getElementById("answers"), "data-choice", s.button_order);
     if (s.status === "waiting-for-answer" && s.question && s.question.round !== shownRound) {
       shownRound = s.question.round;
       Study.betweenRounds(s, () => show(s.question));

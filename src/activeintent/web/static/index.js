@@ -1,0 +1,104 @@
+// Start page. Step 1 (no session yet): the consent text of the study file and the participant
+// ID from the link (?pid= or Prolific's PROLIFIC_PID, STUDY_ID, SESSION_ID), or a typed code.
+// Agreeing creates the session and reloads as /?session=…, step 2: what to do, for the
+// condition this participant was assigned (which only the session knows).
+"use strict";
+
+(async () => {
+  const $ = (id) => document.getElementById(id);
+  const params = new URLSearchParams(location.search);
+  const ID_PATTERN = /^[A-Za-z0-9_-]{1,64}$/; // as the server checks (web/study.py)
+
+  if (Study.sessionId) return showHow();
+
+  let config;
+  try {
+    config = await Study.api("GET", "/api/config");
+  } catch (err) {
+    Study.showFatal(`The study server does not answer: ${err.message}`);
+    return;
+  }
+  $("step-enter").classList.remove("hidden");
+  const pid = params.get("PROLIFIC_PID") ?? params.get("pid");
+  const ids = { pid, study_id: params.get("STUDY_ID"), prolific_session_id: params.get("SESSION_ID") };
+  const names = { pid: "participant ID", study_id: "STUDY_ID", prolific_session_id: "SESSION_ID" };
+  const bad = Object.keys(ids).filter((k) => ids[k] !== null && !ID_PATTERN.test(ids[k]));
+  if (bad.length) {
+    Study.showFatal(`This link's ${bad.map((k) => names[k]).join(" and ")} is not valid (1 to 64 letters, ` +
+      "digits, '_' or '-'). Please open the link you were given again, or contact the researchers.");
+    return;
+  }
+  if (config.require_pid && pid === null) {
+    Study.showFatal("This link has no participant ID (?pid=… or ?PROLIFIC_PID=…). Please open the link you were given.");
+    return;
+  }
+  if (pid !== null) {
+    $("pid-value").textContent = pid;
+    $("pid-line").classList.remove("hidden");
+    $("code-field").classList.add("hidden");
+  }
+  const begin = $("begin");
+  if (config.consent) {
+    const box = $("consent-text");
+    for (const para of config.consent.split(/\n\s*\n/)) {
+      const p = document.createElement("p");
+      p.textContent = para.trim();
+      box.append(p);
+    }
+    $("consent").classList.remove("hidden");
+    begin.textContent = "I agree, continue";
+    $("decline").classList.remove("hidden");
+    $("decline").addEventListener("click", () => {
+      $("step-enter").classList.add("hidden");
+      $("declined").classList.remove("hidden");
+    });
+  }
+  begin.disabled = false;
+  begin.addEventListener("click", async () => {
+    begin.disabled = true;
+    $("status").textContent = "Starting…";
+    const body = {};
+    for (const [k, v] of Object.entries(ids)) if (v !== null) body[k] = v;
+    if (pid === null) body.participant = $("participant").value.trim() || null;
+    if (config.consent) body.consent = true;
+    try {
+      const s = await Study.api("POST", "/api/sessions", body);
+      location.href = `/?session=${encodeURIComponent(s.id)}`;
+    } catch (err) {
+      Study.showFatal(err.message);
+      begin.disabled = false;
+    }
+  });
+
+  async function showHow() {
+    let s;
+    try {
+      s = await Study.api("GET", `/api/sessions/${Study.sessionId}`);
+    } catch (err) {
+      Study.showFatal(err.status === 404 ? "This session does not exist (or the server was restarted)." : err.message);
+      return;
+    }
+    if (s.status !== "waiting-for-learner" && s.status !== "waiting-for-answer") return Study.goTo("/done");
+    $("step-how").classList.remove("hidden");
+    $(s.signal === "preference" ? "how-preference" : "how-stop").classList.remove("hidden");
+    if (s.design === "assigned-rule") {
+      $("rule-text").textContent = s.intention_description;
+      $("rule-assigned").classList.remove("hidden");
+    } else {
+      $("rule-free").classList.remove("hidden");
+    }
+    $("guess-note").textContent = {
+      "always": "From the second round on, the page shows the robot's current guess of your rule.",
+      "after-answer": "After each of your answers, the page shows what the robot now guesses, before the next round.",
+    }[s.show_estimate] || "";
+    $("rounds").textContent = `There are ${s.rounds} rounds; each takes under a minute.`;
+    Study.log("page_load", { page: "start" });
+    Study.poll(() => {}); // keeps the session from going idle while the participant reads
+    const start = $("start");
+    start.disabled = false;
+    start.addEventListener("click", () => {
+      Study.log("start_clicked");
+      Study.goTo(s.signal === "preference" ? "/preference" : "/clicker");
+    });
+  }
+})();
