@@ -5,7 +5,13 @@ from __future__ import annotations
 import numpy as np
 from pydantic import BaseModel
 
-from activeintent.world.scene import BLOCK_SIZE, BOUNDS, BOWL_INNER_RADIUS, footprint_radius
+from activeintent.world.scene import (
+    BLOCK_SIZE,
+    BOUNDS,
+    BOWL_INNER_RADIUS,
+    footprint_radius,
+    kind_of,
+)
 from activeintent.world.state import WorldState
 
 NEXT_TO_GAP = 0.05  # footprints closer than this (m) count as next to each other
@@ -32,18 +38,20 @@ class Relations(BaseModel):
         return tuple(sorted((a, b))) in {tuple(p) for p in self.next_to}
 
 
+_GRID = (
+    ("top left corner", "top side", "top right corner"),
+    ("left side", "middle", "right side"),
+    ("bottom left corner", "bottom side", "bottom right corner"),
+)
+
+
 def table_position_name(xy: tuple[float, float] | np.ndarray) -> str:
     """The Code-as-Policies name of a table region: corners, sides or "middle" (3×3 grid)."""
     x, y = float(xy[0]), float(xy[1])
     (x0, x1), (y0, y1) = BOUNDS
     col = min(2, max(0, int((x - x0) / ((x1 - x0) / 3))))
     row = min(2, max(0, int((y1 - y) / ((y1 - y0) / 3))))
-    names = [
-        ["top left corner", "top side", "top right corner"],
-        ["left side", "middle", "right side"],
-        ["bottom left corner", "bottom side", "bottom right corner"],
-    ]
-    return names[row][col]
+    return _GRID[row][col]
 
 
 _MEMO: dict[tuple, Relations] = {}  # planners and judges ask about the same states again and again
@@ -62,43 +70,51 @@ def relations(state: WorldState) -> Relations:
 
 
 def _relations(state: WorldState) -> Relations:
-    blocks, bowls = state.blocks, state.bowls
+    # Plain floats and precomputed kinds (the same IEEE arithmetic as on numpy arrays): this
+    # runs for every state a planner tries.
+    pos = state.positions
+    kind = {n: kind_of(n) for n in pos}
+    radius = {n: footprint_radius(n) for n in pos}
+    blocks = [n for n in pos if kind[n] == "block"]
+    bowls = [n for n in pos if kind[n] == "bowl"]
     on: list[tuple[str, str]] = []
     inside: list[tuple[str, str]] = []
     for a in blocks:
-        pa = state.pos(a)
+        ax, ay, az = pos[a]
         for b in blocks:
             if a == b:
                 continue
-            pb = state.pos(b)
-            if np.hypot(*(pa[:2] - pb[:2])) < 0.6 * BLOCK_SIZE and abs(pa[2] - pb[2] - BLOCK_SIZE) < 0.015:
+            bx, by, bz = pos[b]
+            if np.hypot(ax - bx, ay - by) < 0.6 * BLOCK_SIZE and abs(az - bz - BLOCK_SIZE) < 0.015:
                 on.append((a, b))
         for w in bowls:
-            pw = state.pos(w)
-            if np.hypot(*(pa[:2] - pw[:2])) < BOWL_INNER_RADIUS and pa[2] < 0.25:
+            wx, wy, _ = pos[w]
+            if np.hypot(ax - wx, ay - wy) < BOWL_INNER_RADIUS and az < 0.25:
                 inside.append((a, w))
     in_bowl = {a for a, _ in inside}
-    on_table = [a for a in blocks if a not in in_bowl and state.pos(a)[2] < BLOCK_SIZE / 2 + LEVEL_TOL]
+    on_table = [a for a in blocks if a not in in_bowl and pos[a][2] < BLOCK_SIZE / 2 + LEVEL_TOL]
+    touching = set(inside) | set(on)
     next_to: list[tuple[str, str]] = []
-    names = state.names
+    names = list(pos)
     for i, a in enumerate(names):
+        ax, ay, az = pos[a]
         for b in names[i + 1 :]:
-            pa, pb = state.pos(a), state.pos(b)
-            if state.kind(a) == "bowl" and state.kind(b) == "bowl":
+            if kind[a] == "bowl" and kind[b] == "bowl":
                 continue
-            if (a, b) in inside or (b, a) in inside or (a, b) in on or (b, a) in on:
+            if (a, b) in touching or (b, a) in touching:
                 continue
+            bx, by, bz = pos[b]
             # Only objects standing on the same surface level are "next to" each other.
-            za = 0.0 if state.kind(a) == "bowl" else pa[2] - BLOCK_SIZE / 2
-            zb = 0.0 if state.kind(b) == "bowl" else pb[2] - BLOCK_SIZE / 2
+            za = 0.0 if kind[a] == "bowl" else az - BLOCK_SIZE / 2
+            zb = 0.0 if kind[b] == "bowl" else bz - BLOCK_SIZE / 2
             if abs(za - zb) > LEVEL_TOL:
                 continue
-            if state.kind(a) == "block" and a in in_bowl or state.kind(b) == "block" and b in in_bowl:
+            if kind[a] == "block" and a in in_bowl or kind[b] == "block" and b in in_bowl:
                 continue
-            gap = np.hypot(*(pa[:2] - pb[:2])) - footprint_radius(a) - footprint_radius(b)
+            gap = np.hypot(ax - bx, ay - by) - radius[a] - radius[b]
             if gap < NEXT_TO_GAP:
                 next_to.append(tuple(sorted((a, b))))  # type: ignore[arg-type]
-    positions = {n: table_position_name(state.pos(n)[:2]) for n in names}
+    positions = {n: table_position_name(pos[n]) for n in names}
     return Relations(on=on, inside=inside, next_to=next_to, on_table=on_table, table_position=positions)
 
 

@@ -7,6 +7,7 @@ workspace x ∈ [-0.3, 0.3] (left → right), y ∈ [-0.8, -0.2] (bottom → top
 from __future__ import annotations
 
 import difflib
+import functools
 from typing import Literal, NamedTuple
 
 import numpy as np
@@ -54,10 +55,12 @@ class ObjectName(NamedTuple):
         )
 
 
+@functools.cache  # asked millions of times about the same few names
 def kind_of(name: str) -> str:
     return name.rsplit(" ", 1)[-1]
 
 
+@functools.cache
 def color_of(name: str) -> str:
     return name.split(" ", 1)[0]
 

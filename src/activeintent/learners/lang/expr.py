@@ -25,6 +25,7 @@ computed once and shared by all expressions).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -363,10 +364,16 @@ REGIONS = {
 
 
 def region_points(region: str) -> list[tuple[float, float]]:
+    """The grid points inside ``region``, nearest its centre first."""
+    return list(_region_points(region))
+
+
+@functools.cache  # planners ask on every step; the grid never changes
+def _region_points(region: str) -> tuple[tuple[float, float], ...]:
     inside = REGIONS[region]
     pts = [q for q in GRID if inside(q)]
     cx, cy = float(np.mean([q[0] for q in pts])), float(np.mean([q[1] for q in pts]))
-    return sorted(pts, key=lambda q: (q[0] - cx) ** 2 + (q[1] - cy) ** 2)
+    return tuple(sorted(pts, key=lambda q: (q[0] - cx) ** 2 + (q[1] - cy) ** 2))
 
 
 class InRegion(Relation):
