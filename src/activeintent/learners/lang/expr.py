@@ -918,20 +918,21 @@ class Form:
         noun = sel.noun(self.sp).replace("block", "blocks", 1)
         return self.structure.sentence(f"the {noun}", self.stp)
 
-    def _judge(self, f: Facts) -> tuple[bool, float]:
-        k = ("form-judge", self.struct, self.stp, self.group_f(f))
+    def judge(self, f: Facts) -> tuple[bool, float]:
+        """(holds, score) in state ``f``, memoised per structure and group (clauses share them)."""
+        g = self.group_f(f)
+        k = ("form-judge", self.struct, self.stp, g)
         got = f.memo.get(k)
         if got is None:
-            g = self.group_f(f)
             got = f.memo[k] = ((True, 1.0) if not g else
                                (self.structure.holds(f, g, self.stp), float(self.structure.score(f, g, self.stp))))
         return got
 
     def holds(self, f: Facts) -> bool:
-        return self._judge(f)[0]
+        return self.judge(f)[0]
 
     def score(self, f: Facts) -> float:
-        return self._judge(f)[1]
+        return self.judge(f)[1]
 
     def moved_off(self, fb: Facts, fa: Facts, b: str) -> bool:
         g = self.group_f(fa)

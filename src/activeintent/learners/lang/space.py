@@ -127,9 +127,7 @@ class Compiled:
             holds[self.each] = h
             score[self.each] = s
         for i in self.forms:
-            c = self.clauses[i]
-            holds[i] = c.holds(f)
-            score[i] = c.score(f)
+            holds[i], score[i] = self.clauses[i].judge(f)
         got = f.memo[key] = (holds, score)
         return got
 
