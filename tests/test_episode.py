@@ -180,3 +180,19 @@ def test_physics_scoring_at_the_end_reports_agreement(tmp_path):
     assert scored and all(t.success_physics is not None for t in scored)
     assert r.physics_disagreements == sum(t.success != t.success_physics for t in scored)
     assert r.env == "pybullet" and (tmp_path / "final.gif").stat().st_size > 0
+
+
+def test_the_final_answer_reported_is_on_the_first_scene_that_can_show_the_intention():
+    """final_z / final_goal (what `run` prints and the final video shows) come from the first test
+    scene the hidden intention can be shown on, not from scene 0 when that one cannot."""
+    for seed in range(12):
+        r = build_episode(RunOptions(method="zero-signal", intention="two-towers", env="symbolic", llm="none",
+                                     budget=0, seed=seed, test_scenes=4, test_pool=4, video="none")).run()
+        if not r.tests[0].feasible:
+            break
+    else:
+        pytest.fail("no seed in 0..11 puts an infeasible scene first")
+    i = r.final_scene
+    assert i is not None and i > 0 and r.tests[i].feasible and not any(t.feasible for t in r.tests[:i])
+    assert (r.final_z, r.final_goal) == (r.tests[i].z, r.tests[i].goal)
+    assert r.final_goal != r.tests[0].goal or r.tests[0].scene != r.tests[i].scene

@@ -75,6 +75,15 @@ class LiveTable:
             self._say(f"[red]model call failed[/red] (the learner goes on without it): {escape(err)}")
         self.model_errors = errors
 
+    def final(self, result) -> None:
+        """The last row: the z and goal the episode ends with (the summary line's final z), on the
+        first test scene that can show the intention."""
+        from rich.markup import escape
+
+        rate = "n/a" if result.success is None else f"{result.success:.2f}"
+        where = "" if result.final_scene is None else f"test scene {result.final_scene + 1}: "
+        self.table.add_row("final", escape(result.final_z), escape(where + result.final_goal), "", "", rate)
+
     def answered(self, log) -> None:
         from rich.markup import escape
 
@@ -188,6 +197,7 @@ def run(
                                                       refresh_per_second=4)
         with shown:
             result = episode.run()
+            live.final(result)
     except (ValueError, FileNotFoundError) as err:
         console.print(f"[red]error:[/red] {err}")
         raise typer.Exit(2) from None

@@ -147,8 +147,9 @@ class EpisodeResult(BaseModel):
     answers: dict[str, int] = Field(default_factory=dict)
     rounds_used: int
     done_at: int | None = None  # first signal count at which the learner said "done"
-    final_z: str = ""
-    final_goal: str = ""
+    final_z: str = ""  # the learner's final z and goal on test scene final_scene: the first that
+    final_goal: str = ""  # can show the hidden intention (scene 0 when none can)
+    final_scene: int | None = None
     retriever: str | None = None
     variant: str | None = None
     llm_calls: int = 0
@@ -163,6 +164,11 @@ class EpisodeResult(BaseModel):
     error: str | None = None
     config: dict = Field(default_factory=dict)
     provenance: dict = Field(default_factory=dict)  # provenance.py: code, versions, CPU, date
+
+
+def first_feasible(intention: Intention, tests: list[tuple[Scene, int]]) -> int:
+    """Index of the first test scene that can show ``intention`` (0 when none can)."""
+    return next((i for i, (scene, _) in enumerate(tests) if intention.feasible(scene)), 0)
 
 
 @dataclass
@@ -266,7 +272,10 @@ class Episode:
         curve's); success over the feasible ones. Physics (a physics env, ``final`` only) runs on
         the curve's scenes."""
         physics = final and self.env.name != "symbolic"
-        shown = self._final_shown_index(tests) if physics and self.show_final else None
+        # The final attempt shown (final.gif, the web's final video) is on a scene that can show
+        # the intention: the same scene final_z comes from (a web study may ask for the first).
+        shown = (self._final_shown_index(tests) if self.show_final else first_feasible(self.intention, tests)) \
+            if physics else None
         logs = []
         for i, (scene, seed) in enumerate(tests if final else tests[:self.config.test_scenes]):
             physics_here = physics and i < self.config.test_scenes
@@ -285,13 +294,14 @@ class Episode:
                 log.success_physics = bool(self.clock.timed("scoring_s", self.intention.satisfied, traj.outcome))
                 log.failure = log.failure or ("; ".join(s.reason or "" for s in traj.failures) or None)
                 self.emit("tested", k, i, scene, est, traj)
-                if i == 0 and self.config.video != "none":
-                    self._video(traj, "final")
             if i == shown:
                 if not physics_here:  # beyond the curve's scenes: run it for showing only, not scored
                     self.clock.timed("env_s", self.env.reset, scene, seed)
                     traj = self.clock.timed("env_s", self.env.execute, plan)
-                self.emit("final_shown", i, scene, est, traj, feasible)
+                if self.config.video != "none":
+                    self._video(traj, "final")
+                if self.show_final:
+                    self.emit("final_shown", i, scene, est, traj, feasible)
             logs.append(log)
         self.learner.drain_transcript()  # scoring calls are not part of any round's record
         self._executor_calls()
@@ -301,11 +311,7 @@ class Episode:
         return rate, logs
 
     def _final_shown_index(self, tests: list[tuple[Scene, int]]) -> int:
-        if self.show_final == "first-feasible":
-            for i, (scene, _) in enumerate(tests):
-                if self.intention.feasible(scene):
-                    return i
-        return 0  # "first", or no test scene can show the intention
+        return first_feasible(self.intention, tests) if self.show_final == "first-feasible" else 0
 
     # -- the loop ------------------------------------------------------------------------------
     def run(self) -> EpisodeResult:
@@ -362,6 +368,7 @@ class Episode:
         physics_scored = [t for t in test_logs if t.feasible and t.success_physics is not None]
         split = {k: round(v, 3) for k, v in self.clock.split.items()}
         split["model_s"] = round(self.model_time() - model0, 3)  # inside learner_s / executor_s
+        final_at = next((i for i, t in enumerate(test_logs) if t.feasible), 0)
         result = EpisodeResult(
             method=self.learner.name,
             intention=self.intention.name,
@@ -382,8 +389,9 @@ class Episode:
             answers=dict(Counter(answer_kind_from_dump(log.answer) for log in logs)),
             rounds_used=len(logs),
             done_at=done_at,
-            final_z=test_logs[0].z if test_logs else "",
-            final_goal=test_logs[0].goal if test_logs else "",
+            final_z=test_logs[final_at].z if test_logs else "",
+            final_goal=test_logs[final_at].goal if test_logs else "",
+            final_scene=final_at if test_logs else None,
             retriever=self.learner.retriever,
             variant=getattr(self.learner, "variant", None),
             llm_calls=calls1[0] - calls0[0],

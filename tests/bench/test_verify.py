@@ -61,6 +61,16 @@ def test_whole_records_are_compared_but_not_timings_or_provenance():
     assert differences(a, b) == {"learner_stats.top": ([["x", 0.9]], [["y", 0.9]])}
 
 
+def test_final_z_is_compared_once_records_say_which_scene_it_comes_from():
+    """Before ``final_scene`` was recorded, final_z came from test scene 0: such a record cannot
+    differ in the field's new meaning; every record that has final_scene is compared on it."""
+    old = {"success": 1.0, "final_z": "on scene 0", "final_goal": "g0"}
+    new = {"success": 1.0, "final_z": "on scene 2", "final_goal": "g2", "final_scene": 2}
+    assert differences(old, new) == {}
+    assert set(differences({**new, "final_z": "other"}, new)) == {"final_z"}
+    assert set(differences({**new, "final_scene": 1}, new)) == {"final_scene"}
+
+
 def test_a_changed_line_is_reported(tmp_path):
     folder = tmp_path / "paper"
     folder.mkdir()

@@ -22,7 +22,11 @@ NOT_VERIFIED = "NOT-VERIFIED.md"  # a folder's own word on why it cannot be re-r
 NOT_COMPARED = frozenset({"wall_s", "time_split", "provenance", "traceback"})
 # Record fields added after format 3 began: compared when the recorded episode has them (an
 # older record cannot differ in a field it never had; every field it has is compared).
-ADDED_IN_FORMAT_3 = frozenset({"diagnostics"})
+ADDED_IN_FORMAT_3 = frozenset({"diagnostics", "final_scene"})
+# Fields whose meaning changed within format 3, compared when the recorded episode has the field
+# that marks the new meaning: final_z / final_goal came from test scene 0 before ``final_scene``
+# (the first scene that can show the intention) was recorded.
+REDEFINED_IN_FORMAT_3 = {"final_z": "final_scene", "final_goal": "final_scene"}
 
 
 class StaleFolder(ValueError):
@@ -37,7 +41,8 @@ def differences(recorded: dict, again: dict, prefix: str = "") -> dict[str, tupl
     """Fields whose values differ, nested keys joined by '.' (``NOT_COMPARED`` left out)."""
     out: dict[str, tuple] = {}
     for key in sorted(set(recorded) | set(again)):
-        if not prefix and (key in NOT_COMPARED or (key in ADDED_IN_FORMAT_3 and key not in recorded)):
+        if not prefix and (key in NOT_COMPARED or (key in ADDED_IN_FORMAT_3 and key not in recorded)
+                           or (key in REDEFINED_IN_FORMAT_3 and REDEFINED_IN_FORMAT_3[key] not in recorded)):
             continue
         a, b = recorded.get(key), again.get(key)
         if isinstance(a, dict) and isinstance(b, dict):
