@@ -91,6 +91,37 @@ def test_the_decision_gain_prefers_the_query_that_separates_plans():
         select_query(*args, gain="decisoin")
 
 
+def test_the_shown_decision_gain_is_the_decision_gain_without_what_feasibility_tells():
+    """Chain rule: I(h, f; c) = I(f; c) + P(f = 0) I(h; c | f = 0), f = "the answer is new scene"."""
+    from activeintent.learners.bayes.needs import p_new_scene
+
+    table = {"t": np.array([[1.0, 0.0], [0.0, 1.0], [0.5, 0.5], [0.2, 0.8]])}
+    w, feasible, classes = np.array([0.4, 0.3, 0.2, 0.1]), np.array([True, True, False, True]), np.array([0, 1, 2, 1])
+    args = (_TableSignal(table), None, None, w, feasible, [Outcome([], "t")], 0.1, np.random.default_rng(0))  # type: ignore[arg-type]
+    full = select_query(*args, gain="decision", classes=classes).gain
+    shown = select_query(*args, gain="shown-decision", classes=classes).gain
+    p_new = p_new_scene(feasible, 0.1)
+    feasibility = class_information(w, np.stack([1 - p_new, p_new], axis=1), classes)
+    assert 0 < shown < full and full == pytest.approx(feasibility + shown, abs=1e-12)
+
+
+def test_needs_scenes_meet_the_requirement_the_needs_belief_holds():
+    from activeintent.learners.bayes.needs import Needs
+
+    def red_share(scenes: str) -> float:
+        got = []
+        for seed in range(6):
+            learner = LangLearner("stop", rng=seed, config=LangConfig(**{**DECIDE, "scenes": scenes}))
+            needs = learner.needs
+            red = next(i for i in range(needs.size) if needs.describe(i) == "block:red")
+            needs.log_v = np.where(np.arange(needs.size) == red, 0.0, np.log(1e-6 / needs.size))
+            got += [("red block" in s.objects) for s in learner._scene_candidates()]
+        return float(np.mean(got))
+
+    assert isinstance(Needs(0.1).draw(np.random.default_rng(0)), int)
+    assert red_share("needs") == 1.0 and red_share("belief") < 0.9  # belief keeps the 4 best of 16 draws
+
+
 def test_goals_that_agree_on_every_deployment_scene_share_a_class():
     keys = ["every colour:red in-bowl:any", "at-least-1 colour:red in-bowl:any", "none colour:red in-bowl:any"]
     space = LangSpace([parse_goal(k) for k in keys])
@@ -117,7 +148,8 @@ def _rounds(config: LangConfig, seed: int = 3) -> list[tuple]:
     return seen
 
 
-@pytest.mark.parametrize("switch", [{"scenes": "random"}, {"gain": "goal"}, {"gain": "shown"}, {"needs": False}])
+@pytest.mark.parametrize("switch", [{"scenes": "random"}, {"scenes": "needs"}, {"gain": "goal"}, {"gain": "shown"},
+                                    {"gain": "shown-decision"}, {"needs": False}])
 def test_every_switch_changes_the_questions(switch):
     assert _rounds(LangConfig(**{**DECIDE, **switch})) != _rounds(LangConfig(**DECIDE))
 

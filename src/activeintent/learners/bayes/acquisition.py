@@ -10,7 +10,8 @@ By the chain rule EIG = I(f; z) + I(h; z | f), f = "the answer is new scene": th
 what the scene's feasibility tells, the second what the shown trajectories tell. ``gain="shown"``
 keeps only the second, P(f = 0) · EIG over the belief restricted to the z the scene can show.
 ``gain="decision"`` scores the information about the decision class of z instead
-(decision.py: z grouped by which plans satisfy them on scenes the robot will meet).
+(decision.py: z grouped by which plans satisfy them on scenes the robot will meet);
+``gain="shown-decision"`` only what the shown trajectories tell about it, P(f = 0) · I(h; c | f = 0).
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from activeintent.learners.bayes.needs import p_new_scene
 from activeintent.signals import Judge, Signal
 from activeintent.world import describe_plan
 
-GAINS = ("goal", "shown", "decision")
+GAINS = ("goal", "shown", "decision", "shown-decision")
 
 
 def _entropy(p: np.ndarray) -> np.ndarray:
@@ -113,7 +114,7 @@ def select_query(
         return Query([outs[i] for i in pick], float("nan"))
     if gain not in GAINS:
         raise ValueError(f"unknown gain {gain!r}; valid gains: {', '.join(GAINS)}")
-    if gain == "decision" and classes is None:
+    if gain.endswith("decision") and classes is None:
         raise ValueError("gain='decision' needs the hypotheses' decision classes")
     if len(weights) > cap:
         idx = particles(weights, cap=cap)
@@ -121,7 +122,7 @@ def select_query(
         weights = weights[idx] / weights[idx].sum()
         if classes is not None:
             classes = np.unique(classes[idx], return_inverse=True)[1].reshape(-1)
-    if gain == "shown":
+    if gain.startswith("shown"):
         p_answer = 1 - p_new_scene(feasible, new_scene_error, refuse)
         p_shown = float(weights @ p_answer)
         w_shown = weights * p_answer / p_shown
@@ -130,6 +131,8 @@ def select_query(
         probs = signal.predictive([outs[i].traj for i in combo], judge, model)
         if gain == "shown":
             g = p_shown * eig(w_shown, probs)
+        elif gain == "shown-decision":
+            g = p_shown * class_information(w_shown, probs, classes)  # type: ignore[arg-type]
         elif gain == "decision":
             g = class_information(weights, with_new_scene(probs, feasible, new_scene_error, refuse), classes)  # type: ignore[arg-type]
         else:

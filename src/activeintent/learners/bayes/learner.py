@@ -64,14 +64,16 @@ class BayesConfig(BaseModel):
     prior: Prior = Field("length", description="length: P(z) ∝ 2^-L(z); uniform: the ablation")
     choose: str = Field("eig", description="eig: largest expected information gain; random: the baseline")
     n_scenes: int = Field(4, ge=1, description="candidate scenes scored per design_scene")
-    scenes: Literal["random", "belief"] = Field(
+    scenes: Literal["random", "belief", "needs"] = Field(
         "random", description="random: n_scenes random scenes; belief: the n_scenes of scene_candidates random "
-        "ones that the belief most expects to show its goals, also after a 'new scene' answer")
+        "ones that the belief most expects to show its goals, also after a 'new scene' answer; needs: as belief, "
+        "each candidate drawn to also meet a requirement drawn from the needs belief")
     scene_candidates: int = Field(16, ge=1, description="scenes drawn per design_scene when scenes = belief")
-    gain: Literal["goal", "shown", "decision"] = Field(
+    gain: Literal["goal", "shown", "decision", "shown-decision"] = Field(
         "goal", description="goal: EIG about z, the 'new scene' answer included; shown: only what the "
         "answers to the shown trajectories tell (the feasibility part of the EIG left out); decision: "
-        "information about which plans to run on scenes of the public test distribution (decision.py)")
+        "information about which plans to run on scenes of the public test distribution (decision.py); "
+        "shown-decision: only what the answers to the shown trajectories tell about that")
     deploy_scenes: int = Field(8, ge=1, description="gain = decision: the learner's own scenes of the test distribution")
     needs: bool = Field(False, description="also learn what the intention needs of a scene's objects from "
                         "'new scene' answers (needs.py)")
@@ -137,11 +139,11 @@ class BayesLearner(Learner):
         self._classes: tuple[tuple[int, int], np.ndarray] | None = None
         self.needs = Needs(self.config.new_scene_error) if self.config.needs else None
         self.deploy = (deployment_states(int(self.rng.integers(2**31)), self.config.deploy_scenes)
-                       if self.config.gain == "decision" else [])
+                       if self.config.gain.endswith("decision") else [])
 
     @property
     def redesigns_after_new_scene(self) -> bool:  # type: ignore[override]
-        return self.config.scenes == "belief"
+        return self.config.scenes != "random"
 
     # ---- belief views ----
 
@@ -190,7 +192,7 @@ class BayesLearner(Learner):
         feasible = self.judge.feasible(tuple(state.positions))  # the planner may have found some z infeasible
         return select_query(self.sig, self.model, self.judge, self.weights, feasible, outs,
                             c.new_scene_error, self.rng, choose=c.choose, gain=c.gain,
-                            classes=self.decision_classes() if c.gain == "decision" else None,
+                            classes=self.decision_classes() if c.gain.endswith("decision") else None,
                             refuse=self.refuse(tuple(state.positions)))
 
     def refuse(self, objects: tuple[str, ...]) -> float:
@@ -227,9 +229,11 @@ class BayesLearner(Learner):
         drawn = []
         for _ in range(c.scene_candidates):
             z = self.hyps[likely[int(self.rng.choice(len(likely), p=w))]]
+            need = self.needs.draw(self.rng) if c.scenes == "needs" and self.needs is not None else None
             for _ in range(20):
                 scene = random_scene(self.rng)
-                if z.can_show(tuple(scene.objects)):
+                objects = tuple(scene.objects)
+                if z.can_show(objects) and (need is None or not self.needs.fails(objects)[need]):  # type: ignore[union-attr]
                     break
             drawn.append(scene)
         mass = np.array([(1 - self.refuse(tuple(s.objects)))

@@ -104,6 +104,10 @@ class Needs:
         objects = tuple(scene.objects) if isinstance(scene, Scene) else tuple(scene)
         return float(self.weights @ self.fails(objects))
 
+    def draw(self, rng: np.random.Generator) -> int:
+        """One requirement R drawn from v (its index)."""
+        return int(rng.choice(self.size, p=self.weights))
+
     def update(self, objects: tuple[str, ...], new_scene: bool, shown: float) -> None:
         """Bayes' rule for one answer; ``shown`` = m, the z belief's P(shown) before it."""
         e = self.error
