@@ -144,3 +144,16 @@ def test_sign_test_and_paired_bootstrap():
     lo, hi = paired_bootstrap(diffs)
     assert 0.1 <= lo <= diffs.mean() <= hi <= 0.3
     assert paired_bootstrap(diffs) == (lo, hi)  # fixed seed: the same report from the same records
+
+
+def test_unscored_episodes_count_in_signals_answers_and_excluded_scenes(tmp_path):
+    """An episode no test scene could score still asked and was answered: its signals, its "new
+    scene" answers and its excluded scenes are in the suite table, beside the unscored count."""
+    scored = {"method": "bayes-stop", "intention": "stack", "trial": 0, "success": 1.0, "success_at": [0.0, 1.0, 1.0],
+              "signals_used": 2, "answers": {"stop": 2}, "test_excluded": 0}
+    unscored = {**scored, "trial": 1, "success": None, "success_at": [None, None, None],
+                "answers": {"new_scene": 2}, "test_excluded": 4}
+    text = write_report([scored, unscored], ["bayes-stop"], ["stack"], tmp_path, SETTINGS).read_text()
+    row = next(line for line in text.splitlines() if line.startswith("| bayes-stop |"))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[3:6] == ["2.0", "2/4", "2.0"] and cells[-1] == "1"

@@ -228,8 +228,10 @@ def _scored_line(by: dict, methods: list[str], names: list[str], labels: dict[st
 
 
 COLUMNS = ("Columns: **intentions** and **all**: success@K, mean over episodes [95 % Wilson interval] "
-           "(n = scored episodes); **signals used**: mean counted answers per episode; **new-scene answers**: "
-           "\"new scene\" answers / all answers, summed over episodes; **test scenes excluded**: mean per episode "
+           "(n = scored episodes); **signals used**, **new-scene answers** and **test scenes excluded** count "
+           "every episode that ran, unscored ones included: **signals used**: mean counted answers per episode; "
+           "**new-scene answers**: \"new scene\" answers / all answers, summed over episodes; **test scenes "
+           "excluded**: mean per episode "
            "of the test scenes scored at k = K where the hidden intention cannot be shown, so left out of "
            "success; **physics disagreements**: test scenes whose physics outcome differed from the symbolic "
            "one, summed / episodes with physics; **errors**: episodes that ended in an error; **unscored**: "
@@ -274,10 +276,11 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
             every = [r for i in names for r in by.get((m, i), [])]
             ok = [r for r in every if _ok(r)]
             cells = [rate([r["success"] for r in by.get((m, i), []) if _ok(r)]) for i in names]
-            signals = np.mean([r.get("signals_used", 0) for r in ok]) if ok else 0
-            new = sum((r.get("answers") or {}).get("new_scene", 0) for r in ok)
-            total = sum(sum((r.get("answers") or {}).values()) for r in ok)
-            excl = np.mean([r.get("test_excluded", 0) for r in ok]) if ok else 0
+            ran = [r for r in every if not r.get("error")]  # unscored episodes asked and were answered too
+            signals = np.mean([r.get("signals_used", 0) for r in ran]) if ran else 0
+            new = sum((r.get("answers") or {}).get("new_scene", 0) for r in ran)
+            total = sum(sum((r.get("answers") or {}).values()) for r in ran)
+            excl = np.mean([r.get("test_excluded", 0) for r in ran]) if ran else 0
             phys = [r for r in ok if r.get("physics_disagreements") is not None]
             dis = f"{sum(r['physics_disagreements'] for r in phys)} / {len(phys)} ep." if phys else "–"
             label = f"*{m}* (baseline)" if m in BASELINES else m
