@@ -8,7 +8,11 @@
 - ``decide-goal-gain-<signal>``: scenes from the belief, queries by EIG about z (lang's gain);
 - ``decide-shown-gain-<signal>``: scenes from the belief, EIG about z without what the scene's
   feasibility tells;
-- ``decide-no-needs-<signal>``: no belief over what the intention needs of a scene's objects.
+- ``decide-no-needs-<signal>``: no belief over what the intention needs of a scene's objects;
+- ``decide-shown-decision-gain-<signal>``: the decision gain without what the scene's
+  feasibility tells (only the answers to the shown trajectories);
+- ``decide-needs-scenes-<signal>`` (a variant, not an ablation): each candidate scene also meets a
+  requirement drawn from the needs belief.
 """
 
 from activeintent.learners.lang.learner import DECIDE, LangConfig, LangLearner
@@ -19,6 +23,8 @@ ABLATIONS = {
     "goal-gain": {"gain": "goal"},
     "shown-gain": {"gain": "shown"},
     "no-needs": {"needs": False},
+    "shown-decision-gain": {"gain": "shown-decision"},
+    "needs-scenes": {"scenes": "needs"},
 }
 
 
@@ -31,7 +37,8 @@ def _ablation(part: str, signal: str) -> Method:
         learner.name = name
         return learner
 
-    return Method(signal, False, build, f"ablation: decide-{signal} with {ABLATIONS[part]}")
+    kind = "variant" if part == "needs-scenes" else "ablation"
+    return Method(signal, False, build, f"{kind}: decide-{signal} with {ABLATIONS[part]}")
 
 
 for _part in ABLATIONS:
