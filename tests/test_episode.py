@@ -196,3 +196,20 @@ def test_the_final_answer_reported_is_on_the_first_scene_that_can_show_the_inten
     assert i is not None and i > 0 and r.tests[i].feasible and not any(t.feasible for t in r.tests[:i])
     assert (r.final_z, r.final_goal) == (r.tests[i].z, r.tests[i].goal)
     assert r.final_goal != r.tests[0].goal or r.tests[0].scene != r.tests[i].scene
+
+
+def test_a_free_rule_final_attempt_is_on_the_first_scene_the_learners_belief_can_show():
+    """show_final = learner-showable reads the learner's own P(shown), never the hidden rule."""
+    from activeintent.protocol import draw_test_scenes
+
+    tests = draw_test_scenes(3, 4)
+    episode = build_episode(RunOptions(method="bayes-stop", intention="stack", env="symbolic", llm="none",
+                                       budget=0, seed=0, test_scenes=2, test_pool=2, video="none"),
+                            show_final="learner-showable")
+    episode.learner.shown_mass = lambda scene: 0.9 if scene is tests[2][0] else 0.1
+    assert episode._final_shown_index(tests) == 2
+    episode.learner.shown_mass = lambda scene: 0.1
+    assert episode._final_shown_index(tests) == 0
+    episode.show_final = "first"
+    episode.learner.shown_mass = lambda scene: 0.9 if scene is tests[2][0] else 0.1
+    assert episode._final_shown_index(tests) == 0

@@ -201,13 +201,15 @@ class Episode:
         model_time: Callable[[], float] | None = None,
         extra_config: dict | None = None,
         out_dir: str | Path | None = None,
-        show_final: Literal["first", "first-feasible"] | None = None,
+        show_final: Literal["first", "first-feasible", "learner-showable"] | None = None,
     ):
         self.learner, self.intention, self.user = learner, intention, user
         # Opt-in (the web study): after the final scoring, emit ``final_shown`` with one test
-        # scene's physics execution, the first test scene ("first") or the first on which the
-        # intention can be shown at all ("first-feasible"). Not part of the records: None
-        # (the default) changes nothing.
+        # scene's physics execution, the first test scene ("first"), the first on which the
+        # intention can be shown at all ("first-feasible", an assigned rule) or the first the
+        # learner's own belief expects to show its goals on ("learner-showable", a free rule: the
+        # learner's P(shown) ≥ 0.5; the first scene for learners without a belief). Not part of
+        # the records: None (the default) changes nothing.
         self.show_final = show_final
         self.executor, self.env = executor, env
         self.config = config or EpisodeConfig()
@@ -311,7 +313,13 @@ class Episode:
         return rate, logs
 
     def _final_shown_index(self, tests: list[tuple[Scene, int]]) -> int:
-        return first_feasible(self.intention, tests) if self.show_final == "first-feasible" else 0
+        if self.show_final == "first-feasible":
+            return first_feasible(self.intention, tests)
+        if self.show_final == "learner-showable":  # the learner's own P(shown), never the hidden rule
+            mass = getattr(self.learner, "shown_mass", None)
+            if mass is not None:
+                return next((i for i, (scene, _) in enumerate(tests) if mass(scene) >= 0.5), 0)
+        return 0
 
     # -- the loop ------------------------------------------------------------------------------
     def run(self) -> EpisodeResult:

@@ -392,8 +392,9 @@ def runner_builder(config: StudyConfig, **options: Any) -> EpisodeBuilder:
     elif config.intention is not None:
         base["intention"] = config.intention
     # The final attempt is what participants judge: with an assigned rule, on a table where
-    # that rule can be shown at all; a free rule is unknown, so the first table.
-    show = "first-feasible" if config.design == "assigned-rule" else "first"
+    # that rule can be shown at all; a free rule is unknown, so on the first table the learner's
+    # own belief expects to be able to show its goals on.
+    show = "first-feasible" if config.design == "assigned-rule" else "learner-showable"
 
     def build(seed: int, out_dir: Path, user, observers):
         from activeintent.runner import RunOptions, build_episode
