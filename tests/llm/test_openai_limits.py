@@ -73,6 +73,7 @@ MALFORMED = {
     "a list": (b"[1, 2]", "not a chat completion"),
     "NaN usage": (_body().replace(b'"prompt_tokens": 11', b'"prompt_tokens": NaN'), "NaN is not a JSON number"),
     "fractional usage": (_body(usage={"prompt_tokens": 1.5, "completion_tokens": 1}), "prompt_tokens"),
+    "usage as text": (_body(usage={"prompt_tokens": "11", "completion_tokens": 1}), "prompt_tokens"),
     "negative usage": (_body(usage={"prompt_tokens": -1, "completion_tokens": 1}), "prompt_tokens"),
 }
 

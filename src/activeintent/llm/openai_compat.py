@@ -167,24 +167,28 @@ def _bounded_client(base_url: str | None, budget: _Budget, limits: CallLimits, r
     return openai.DefaultHttpxClient(transport=transport, timeout=httpx2.Timeout(read_s, connect=limits.connect_s))
 
 
-class _Message(BaseModel):
+class _Strict(BaseModel):
+    """Parts of a chat-completions body; strict, so a wrong type ("11" tokens) is not coerced."""
+
+    model_config = ConfigDict(strict=True)
+
+
+class _Message(_Strict):
     content: str | None = None
 
 
-class _Choice(BaseModel):
+class _Choice(_Strict):
     message: _Message
     finish_reason: str | None = None
 
 
-class _Usage(BaseModel):
+class _Usage(_Strict):
     prompt_tokens: int = Field(default=0, ge=0)
     completion_tokens: int = Field(default=0, ge=0)
 
 
-class _Answer(BaseModel):
-    """The part of a chat-completions body we use; strict, so a wrong type is not coerced."""
-
-    model_config = ConfigDict(strict=True)
+class _Answer(_Strict):
+    """The part of a chat-completions body we use."""
 
     choices: list[_Choice] = Field(min_length=1)
     usage: _Usage | None = None
