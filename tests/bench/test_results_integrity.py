@@ -14,7 +14,7 @@ from pathlib import Path
 from typer.testing import CliRunner
 
 from activeintent.cli import app
-from activeintent.records import hold_results_folder, load_results
+from activeintent.results import hold_results_folder, load_results
 
 ROOT = Path(__file__).resolve().parents[2]
 TINY = ["--methods", "zero-signal", "--intentions", "color-match", "--budget", "2", "--test-scenes", "2",

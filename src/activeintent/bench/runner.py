@@ -29,7 +29,7 @@ from pydantic import BaseModel, Field
 
 from activeintent.learners.registry import PAPER_METHODS
 from activeintent.protocol import trial_seeds
-from activeintent.records import (
+from activeintent.results import (
     Rejected,
     append_result,
     hold_results_folder,
