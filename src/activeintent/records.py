@@ -1,12 +1,12 @@
 """The on-disk formats, owned here only: ``summary.json`` and ``rounds.jsonl`` of an episode,
-``results.jsonl`` of a benchmark. Every record carries ``format`` (FORMAT_VERSION) so an old
+``results.jsonl`` of a benchmark (its lines are written by :func:`dumps`; reading, checking and
+appending them is results.py's). Every record carries ``format`` (FORMAT_VERSION) so an old
 folder is never read as a new one.
 """
 
 from __future__ import annotations
 
 import json
-import os
 import unicodedata
 from pathlib import Path
 
@@ -50,33 +50,3 @@ class EpisodeRecorder:
 
 def read_rounds(path: str | Path) -> list[dict]:
     return [json.loads(line) for line in Path(path).read_text().splitlines() if line.strip()]
-
-
-def read_results(path: Path) -> list[dict]:
-    """Valid records of ``results.jsonl``; a torn or corrupt line is dropped (and the file rewritten)."""
-    if not path.exists():
-        return []
-    good, bad = [], 0
-    for line in path.read_text().splitlines():
-        try:
-            rec = json.loads(line)
-            if isinstance(rec, dict) and {"method", "intention", "trial"} <= rec.keys():
-                good.append(rec)
-                continue
-        except json.JSONDecodeError:
-            pass
-        bad += int(bool(line.strip()))
-    if bad:
-        tmp = path.with_suffix(".jsonl.tmp")
-        tmp.write_text("".join(dumps(r) + "\n" for r in good))
-        os.replace(tmp, path)
-    return good
-
-
-def append_result(path: Path, record: dict) -> None:
-    """One line per finished episode, flushed and fsynced: a kill loses at most what is in flight."""
-    line = dumps({"format": FORMAT_VERSION, **record}) + "\n"
-    with path.open("a") as f:
-        f.write(line)
-        f.flush()
-        os.fsync(f.fileno())

@@ -17,7 +17,7 @@ import pytest
 from activeintent.bench.report import wilson, write_report
 from activeintent.bench.runner import BenchOptions, run_bench
 from activeintent.protocol import FORMAT_VERSION, trial_seeds
-from activeintent.records import read_results
+from activeintent.results import read_results
 from activeintent.runner import RunOptions
 
 ROOT = Path(__file__).resolve().parents[2]

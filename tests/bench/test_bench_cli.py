@@ -40,7 +40,7 @@ def test_a_named_suite_still_runs_beside_an_intention_file(tmp_path, monkeypatch
     from activeintent.suites import suite
 
     asked = []
-    monkeypatch.setattr(bench_runner, "run_bench", lambda options, out, on_done: asked.append(options) or [])
+    monkeypatch.setattr(bench_runner, "run_bench", lambda options, out, *hooks: asked.append(options) or [])
     res = runner.invoke(app, ["bench", "--methods", "zero-signal", "--suite", "paper", "--intention-file", MINE,
                               *TINY, "--out", str(tmp_path)])
     assert res.exit_code == 0, res.output

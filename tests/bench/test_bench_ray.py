@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from activeintent.bench.runner import BenchOptions, run_bench
-from activeintent.records import read_results
+from activeintent.results import read_results
 from activeintent.runner import RunOptions
 
 ray = pytest.importorskip("ray")

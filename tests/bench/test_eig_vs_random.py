@@ -12,7 +12,7 @@ import pytest
 
 from activeintent.bench.report import PAIRED, paired_difference
 from activeintent.bench.verify import verify
-from activeintent.records import read_results
+from activeintent.results import read_results
 from activeintent.suites import suite
 
 FOLDER = Path(__file__).resolve().parents[2] / "docs" / "results" / "eig-vs-random"

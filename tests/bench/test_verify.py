@@ -12,7 +12,7 @@ import pytest
 
 from activeintent.bench.verify import NOT_VERIFIED, StaleFolder, differences, sample_records, verify
 from activeintent.protocol import FORMAT_VERSION
-from activeintent.records import read_results
+from activeintent.results import read_results
 
 RESULTS = Path(__file__).resolve().parents[2] / "docs" / "results"
 PAPER = RESULTS / "paper"

@@ -325,7 +325,7 @@ def test_bench_preset_table1_runs_the_papers_methods_beside_its_rows(tmp_path, m
     from typer.testing import CliRunner
 
     from activeintent.cli import app
-    from activeintent.records import read_results
+    from activeintent.results import read_results
 
     monkeypatch.setenv("OPENAI_API_KEY", "test")
     runner = CliRunner()

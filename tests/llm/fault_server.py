@@ -36,8 +36,29 @@ class Ok:
 
 
 class Status:
-    def __init__(self, code: int, message: str = "injected failure") -> None:
-        self.code, self.message = code, message
+    def __init__(self, code: int, message: str = "injected failure", headers: dict[str, str] | None = None) -> None:
+        self.code, self.message, self.headers = code, message, headers or {}
+
+
+class Raw:
+    """A 200 with exactly these body bytes (not UTF-8, not JSON, the wrong shape, NaN...)."""
+
+    def __init__(self, body: bytes) -> None:
+        self.body = body
+
+
+class Drip:
+    """A valid answer, headers included, one byte every ``interval`` seconds."""
+
+    def __init__(self, interval: float, content: str = "dripped") -> None:
+        self.interval, self.content = interval, content
+
+
+class Huge:
+    """A 200 promising ``total`` bytes and sending them for as long as the client reads."""
+
+    def __init__(self, total: int) -> None:
+        self.total = total
 
 
 class Hang:
@@ -63,6 +84,7 @@ class FaultServer:
         self.script: deque[Any] = deque()
         self.requests: list[dict[str, Any]] = []
         self.default: Any = Ok("default answer")
+        self.bytes_sent = 0  # by Huge
         self._release = threading.Event()
         server = self
 
@@ -85,7 +107,35 @@ class FaultServer:
                     self._send(200, payload.encode())
                 elif isinstance(action, Status):
                     err = {"error": {"message": action.message, "type": "injected", "code": action.code}}
-                    self._send(action.code, json.dumps(err).encode())
+                    self._send(action.code, json.dumps(err).encode(), action.headers)
+                elif isinstance(action, Raw):
+                    self._send(200, action.body)
+                elif isinstance(action, Drip):
+                    body = json.dumps(completion_body(action.content)).encode()
+                    head = (f"HTTP/1.1 200 OK\r\nContent-Type: application/json\r\n"
+                            f"Content-Length: {len(body)}\r\n\r\n").encode()
+                    self.close_connection = True
+                    try:
+                        for i in range(len(head + body)):
+                            if server._release.wait(action.interval):
+                                return
+                            self.wfile.write((head + body)[i:i + 1])
+                            self.wfile.flush()
+                    except OSError:  # the client gave up
+                        return
+                elif isinstance(action, Huge):
+                    self.send_response(200)
+                    self.send_header("Content-Type", "application/json")
+                    self.send_header("Content-Length", str(action.total))
+                    self.end_headers()
+                    self.close_connection = True
+                    chunk = b" " * 65536
+                    try:
+                        while server.bytes_sent < action.total and not server._release.is_set():
+                            self.wfile.write(chunk)
+                            server.bytes_sent += len(chunk)
+                    except OSError:  # the client stopped reading and closed
+                        return
                 elif isinstance(action, Hang):
                     server._release.wait()
                     self.close_connection = True
@@ -104,10 +154,12 @@ class FaultServer:
                 else:
                     raise AssertionError(f"unknown action {action!r}")
 
-            def _send(self, code: int, payload: bytes) -> None:
+            def _send(self, code: int, payload: bytes, headers: dict[str, str] | None = None) -> None:
                 self.send_response(code)
                 self.send_header("Content-Type", "application/json")
                 self.send_header("Content-Length", str(len(payload)))
+                for name, value in (headers or {}).items():
+                    self.send_header(name, value)
                 self.end_headers()
                 self.wfile.write(payload)
 

@@ -123,7 +123,7 @@ def bench(
         if console.is_terminal:
             records = _run_with_progress_bar(console, options, out, names)
         else:  # a log sees a live bar only at the end: a flushed line per episode instead
-            records = run_bench(options, out, _ProgressLines(console, names))
+            records = run_bench(options, out, _ProgressLines(console, names), _RejectedLines(console))
     except ValueError as err:
         console.print(f"[red]error:[/red] {err}")
         raise typer.Exit(2) from None
@@ -138,6 +138,27 @@ def bench(
 def _outcome(record: dict) -> str:
     s = record.get("success")
     return "[red]error[/red]" if record.get("error") else ("–" if s is None else f"{s:.2f}")
+
+
+class _RejectedLines:
+    """``on_rejected``: say which lines of results.jsonl were not trusted, and why."""
+
+    SHOWN = 5
+
+    def __init__(self, console):
+        self.console = console
+
+    def __call__(self, rejected: list, where: Path) -> None:
+        from rich.markup import escape
+
+        from activeintent.progress_lines import print_line
+
+        print_line(self.console, f"[yellow]warning:[/yellow] {len(rejected)} line(s) of results.jsonl not trusted, "
+                   f"moved to {escape(str(where))} (their episodes run again):")
+        for r in rejected[:self.SHOWN]:
+            print_line(self.console, f"  line {r.line}: {escape(r.reason)}")
+        if len(rejected) > self.SHOWN:
+            print_line(self.console, f"  … and {len(rejected) - self.SHOWN} more")
 
 
 class _ProgressLines:
@@ -193,4 +214,4 @@ def _run_with_progress_bar(console, options, out: Path, names: dict[str, str]) -
             else:
                 progress.update(task, completed=finished)
 
-        return run_bench(options, out, on_done)
+        return run_bench(options, out, on_done, _RejectedLines(progress.console))

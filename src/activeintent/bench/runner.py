@@ -4,12 +4,20 @@ Trial t of every method uses the same episode seed (from the bench seed, the int
 the same query scenes and user noise) and every method *and intention* of trial t the same
 test scenes (from the bench seed and t only). Each finished episode is appended to
 ``results.jsonl`` by the single parent process (records.py), so a killed run loses at most
-the episodes in flight; a torn last line is dropped on resume.
+the episodes in flight. The folder is locked for the run (one writer); on resume every line is
+checked and the untrusted ones (torn, undecodable, invalid, duplicate) are moved to
+``rejected.jsonl``. Pool workers die with the parent, however it ends.
 """
 
 from __future__ import annotations
 
+import ctypes
 import json
+import os
+import signal
+import sys
+import threading
+import time
 import traceback
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
@@ -21,7 +29,14 @@ from pydantic import BaseModel, Field
 
 from activeintent.learners.registry import PAPER_METHODS
 from activeintent.protocol import trial_seeds
-from activeintent.records import append_result, dumps, read_results
+from activeintent.results import (
+    Rejected,
+    append_result,
+    hold_results_folder,
+    load_results,
+    rewrite_results,
+    set_aside_rejected,
+)
 from activeintent.runner import RunOptions
 
 
@@ -92,31 +107,37 @@ def run_item(item: WorkItem, options: RunOptions, bench_seed: int, out: str, kee
                 "traceback": traceback.format_exc(limit=8)}
 
 
-def run_bench(options: BenchOptions, out: Path, on_done: Callable[[dict, int, int], None] | None = None) -> list[dict]:
-    """Run what is missing from ``out/results.jsonl``; returns all records."""
-    out.mkdir(parents=True, exist_ok=True)
-    results_path = out / "results.jsonl"
-    _check_same_settings(options, out / "bench.json")
-    (out / "bench.json").write_text(options.model_dump_json(indent=2))
-    records = read_results(results_path)
-    if options.retry_errors:
-        kept = [r for r in records if not r.get("error")]
-        if len(kept) != len(records):
-            results_path.write_text("".join(dumps(r) + "\n" for r in kept))
-        records = kept
-    done = {(r["method"], r["intention"], r["trial"]) for r in records}
-    todo = [it for it in options.items() if it.key not in done]
-    total = len(options.items())
-    finished = total - len(todo)
-    if on_done:
-        on_done({}, finished, total)
-    for record in _execute(todo, options, out):
-        append_result(results_path, record)
-        records.append(record)
-        finished += 1
+def run_bench(options: BenchOptions, out: Path, on_done: Callable[[dict, int, int], None] | None = None,
+              on_rejected: Callable[[list[Rejected], Path], None] | None = None) -> list[dict]:
+    """Run what is missing from ``out/results.jsonl``; returns all records. ``on_rejected`` hears
+    of the lines set aside into ``rejected.jsonl`` (never counted, never fatal)."""
+    with hold_results_folder(out):
+        results_path = out / "results.jsonl"
+        _check_same_settings(options, out / "bench.json")
+        (out / "bench.json").write_text(options.model_dump_json(indent=2))
+        loaded = load_results(results_path)
+        rejected_file = set_aside_rejected(results_path, loaded)
+        if rejected_file is not None and on_rejected:
+            on_rejected(loaded.rejected, rejected_file)
+        records = loaded.records
+        if options.retry_errors:
+            kept = [(r, raw) for r, raw in zip(loaded.records, loaded.raw, strict=True) if not r.get("error")]
+            if len(kept) != len(records):
+                rewrite_results(results_path, [raw for _, raw in kept])
+            records = [r for r, _ in kept]
+        done = {(r["method"], r["intention"], r["trial"]) for r in records}
+        todo = [it for it in options.items() if it.key not in done]
+        total = len(options.items())
+        finished = total - len(todo)
         if on_done:
-            on_done(record, finished, total)
-    return records
+            on_done({}, finished, total)
+        for record in _execute(todo, options, out):
+            append_result(results_path, record)
+            records.append(record)
+            finished += 1
+            if on_done:
+                on_done(record, finished, total)
+        return records
 
 
 _SETTINGS = ("seed", "run")  # methods, intentions and trials may grow on resume; these may not change
@@ -188,4 +209,30 @@ def _execute(todo: list[WorkItem], options: BenchOptions, out: Path) -> Iterator
 
 def _pool(jobs: int) -> ProcessPoolExecutor:
     # spawn: every worker starts clean (own PyBullet client, own llama.cpp handle).
-    return ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn"))
+    return ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn"),
+                               initializer=die_with_parent, initargs=(os.getpid(),))
+
+
+PR_SET_PDEATHSIG = 1  # linux/prctl.h
+PARENT_POLL_S = 1.0
+
+
+def die_with_parent(parent: int) -> None:
+    """Pool worker initializer. A worker whose bench is gone (kill -9) would wait for work
+    forever, holding its memory (and keeping the resource tracker alive): on Linux the kernel
+    kills it when the parent dies (PR_SET_PDEATHSIG); elsewhere, and as a second line, a
+    watchdog thread exits when the parent changes."""
+    if sys.platform.startswith("linux"):
+        try:
+            ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+        except (OSError, AttributeError):
+            pass  # the watchdog still covers it
+    if os.getppid() != parent:  # the parent died before the signal was armed
+        os._exit(1)
+    threading.Thread(target=_watch_parent, args=(parent,), name="parent-watchdog", daemon=True).start()
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(PARENT_POLL_S)
+    os._exit(1)

@@ -5,18 +5,30 @@ Structured output asks for ``response_format: json_schema``; a server that rejec
 with ``json_object``, then with plain text (the schema is always in the prompt too); the answer
 is validated above this layer and repaired when it does not parse. Transient failures are
 retried here with exponential backoff and jitter, then raised as typed errors.
+
+Every call is bounded (:class:`CallLimits`): a connect timeout, an overall deadline over all its
+attempts and waits (enforced on every socket read and write, so a server that drips bytes
+cannot stretch it), and a cap on the bytes read. The body is parsed here, strictly: anything
+but UTF-8 JSON of the chat-completions shape with finite, whole token counts is a ModelError.
 """
 
 from __future__ import annotations
 
 import base64
+import email.utils
 import json
 import os
+import threading
 import time
+import urllib.request
 from collections.abc import Callable
 from typing import Any
+from urllib.parse import urlsplit
 
+import httpcore2
+import httpx2
 import openai
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from activeintent.llm.backend import (
     Backend,
@@ -39,6 +51,184 @@ from activeintent.llm.retry import RetryOutcome, RetryPolicy, Transient, run_wit
 # takes (it turns the schema into a grammar).
 FORMAT_MODES = ("json_schema", "json_object_schema", "json_object", "text")
 DUMMY_API_KEY = "sk-no-key-needed"
+
+# Environment variables that set CallLimits (forwarded to bench workers, Ray's too).
+ENV_CONNECT_S = "ACTIVEINTENT_MODEL_CONNECT_S"
+ENV_DEADLINE_S = "ACTIVEINTENT_MODEL_DEADLINE_S"
+ENV_MAX_BYTES = "ACTIVEINTENT_MODEL_MAX_BYTES"
+
+
+class CallLimits(BaseModel):
+    """Bounds of one model call (``complete``: every attempt, retry wait and format fallback)."""
+
+    connect_s: float = Field(default=10.0, gt=0)  # to open the connection
+    deadline_s: float = Field(default=180.0, gt=0)  # the whole call, however the server behaves
+    max_response_bytes: int = Field(default=8 * 2**20, gt=0)  # read per attempt (headers and body)
+
+    @classmethod
+    def from_env(cls) -> CallLimits:
+        """The defaults, overridden by ACTIVEINTENT_MODEL_CONNECT_S / _DEADLINE_S / _MAX_BYTES."""
+        values: dict[str, Any] = {}
+        for field, name in (("connect_s", ENV_CONNECT_S), ("deadline_s", ENV_DEADLINE_S),
+                            ("max_response_bytes", ENV_MAX_BYTES)):
+            if os.environ.get(name):
+                values[field] = os.environ[name]
+        try:
+            return cls.model_validate(values)
+        except ValidationError as err:
+            raise ValueError(f"bad model call limit in the environment ({ENV_CONNECT_S}, {ENV_DEADLINE_S}, "
+                             f"{ENV_MAX_BYTES}): {err.errors()[0]['msg']}") from None
+
+
+class _Budget(threading.local):
+    """What the current attempt may still spend: time until ``deadline`` and ``left`` bytes.
+    ``tripped`` says which bound stopped it ("deadline" | "size")."""
+
+    deadline: float | None = None
+    left: int = 0
+    tripped: str | None = None
+
+    def start(self, deadline: float, max_bytes: int) -> None:
+        self.deadline, self.left, self.tripped = deadline, max_bytes, None
+
+    def timeout(self, timeout: float | None, error: type[Exception]) -> float | None:
+        if self.deadline is None:
+            return timeout
+        remaining = self.deadline - time.monotonic()
+        if remaining <= 0:
+            self.tripped = "deadline"
+            raise error("the call's deadline has passed")
+        return remaining if timeout is None else min(timeout, remaining)
+
+    def spend(self, n: int) -> None:
+        if self.deadline is None:
+            return
+        self.left -= n
+        if self.left < 0:
+            self.tripped = "size"
+            raise httpcore2.ReadError("response larger than the cap")
+
+
+class _BoundedStream(httpcore2.NetworkStream):
+    """A connection whose every read and write ends by the deadline and counts its bytes."""
+
+    def __init__(self, inner: httpcore2.NetworkStream, budget: _Budget) -> None:
+        self.inner, self.budget = inner, budget
+
+    def read(self, max_bytes: int, timeout: float | None = None) -> bytes:
+        data = self.inner.read(max_bytes, self.budget.timeout(timeout, httpcore2.ReadTimeout))
+        self.budget.spend(len(data))
+        return data
+
+    def write(self, buffer: bytes, timeout: float | None = None) -> None:
+        self.inner.write(buffer, self.budget.timeout(timeout, httpcore2.WriteTimeout))
+
+    def close(self) -> None:
+        self.inner.close()
+
+    def start_tls(self, ssl_context: Any, server_hostname: str | None = None,
+                  timeout: float | None = None) -> httpcore2.NetworkStream:
+        tls = self.inner.start_tls(ssl_context, server_hostname, self.budget.timeout(timeout, httpcore2.ConnectTimeout))
+        return _BoundedStream(tls, self.budget)
+
+    def get_extra_info(self, info: str) -> Any:
+        return self.inner.get_extra_info(info)
+
+
+class _BoundedBackend(httpcore2.NetworkBackend):
+    def __init__(self, budget: _Budget) -> None:
+        self.inner, self.budget = httpcore2.SyncBackend(), budget
+
+    def connect_tcp(self, host: str, port: int, timeout: float | None = None, local_address: str | None = None,
+                    socket_options: Any = None) -> httpcore2.NetworkStream:
+        stream = self.inner.connect_tcp(host, port, self.budget.timeout(timeout, httpcore2.ConnectTimeout),
+                                        local_address, socket_options)
+        return _BoundedStream(stream, self.budget)
+
+    def connect_unix_socket(self, path: str, timeout: float | None = None,
+                            socket_options: Any = None) -> httpcore2.NetworkStream:
+        stream = self.inner.connect_unix_socket(path, self.budget.timeout(timeout, httpcore2.ConnectTimeout),
+                                                socket_options)
+        return _BoundedStream(stream, self.budget)
+
+    def sleep(self, seconds: float) -> None:
+        self.inner.sleep(seconds)
+
+
+def _bounded_client(base_url: str | None, budget: _Budget, limits: CallLimits, read_s: float) -> httpx2.Client:
+    """The SDK's HTTP client, reading through :class:`_BoundedBackend`. httpx2 takes no network
+    backend, so the pool it built gets ours (a test fails should that attribute go). An explicit
+    transport turns off the environment's proxies: the one for this URL is passed on."""
+    url = urlsplit(base_url or "https://api.openai.com/v1")
+    proxies = urllib.request.getproxies()
+    proxy = None if urllib.request.proxy_bypass(url.hostname or "") else proxies.get(url.scheme)
+    transport = httpx2.HTTPTransport(proxy=proxy)
+    transport._pool._network_backend = _BoundedBackend(budget)  # noqa: SLF001
+    return openai.DefaultHttpxClient(transport=transport, timeout=httpx2.Timeout(read_s, connect=limits.connect_s))
+
+
+class _Strict(BaseModel):
+    """Parts of a chat-completions body; strict, so a wrong type ("11" tokens) is not coerced."""
+
+    model_config = ConfigDict(strict=True)
+
+
+class _Message(_Strict):
+    content: str | None = None
+
+
+class _Choice(_Strict):
+    message: _Message
+    finish_reason: str | None = None
+
+
+class _Usage(_Strict):
+    prompt_tokens: int = Field(default=0, ge=0)
+    completion_tokens: int = Field(default=0, ge=0)
+
+
+class _Answer(_Strict):
+    """The part of a chat-completions body we use."""
+
+    choices: list[_Choice] = Field(min_length=1)
+    usage: _Usage | None = None
+
+
+def _not_a_number(name: str) -> Any:
+    raise ValueError(f"{name} is not a JSON number")
+
+
+def parse_answer(body: bytes) -> _Answer:
+    """The body of a 200, or a ValueError saying what is wrong with it."""
+    try:
+        text = body.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"the body is not UTF-8 ({exc.reason} at byte {exc.start})") from None
+    try:
+        data = json.loads(text, parse_constant=_not_a_number)
+    except ValueError as exc:
+        raise ValueError(f"the body is not JSON ({exc}): {text[:80]!r}") from None
+    try:
+        return _Answer.model_validate(data)
+    except ValidationError as exc:
+        problems = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'body'}: {e['msg']}" for e in exc.errors()[:3])
+        raise ValueError(f"the body is not a chat completion ({problems})") from None
+
+
+def retry_after_s(headers: Any) -> float | None:
+    """Retry-After in seconds (a number or an HTTP date), None when absent or unreadable."""
+    value = (headers.get("retry-after") or "").strip() if headers is not None else ""
+    if not value:
+        return None
+    try:
+        return max(0.0, float(value))
+    except ValueError:
+        pass
+    try:
+        when = email.utils.parsedate_to_datetime(value)
+    except (TypeError, ValueError):
+        return None
+    return max(0.0, when.timestamp() - time.time())
 
 
 def encode_messages(messages: list[Message]) -> list[dict[str, Any]]:
@@ -93,6 +283,7 @@ class OpenAIBackend(Backend):
         accepts_images: bool = True,
         seed: int = 0,
         sleep: Callable[[float], None] = time.sleep,
+        limits: CallLimits | None = None,
     ) -> None:
         if not model:
             raise ValueError("openai:<model-name> needs a model name, e.g. openai:gpt-4o-mini")
@@ -111,9 +302,14 @@ class OpenAIBackend(Backend):
         self.seed = seed
         self.retry = retry or RetryPolicy()
         self._sleep = sleep
-        # Retries are ours (typed errors, seeded jitter), so the SDK's own are off.
+        self.limits = limits or CallLimits.from_env()
+        self._budget = _Budget()
+        self._deadline = 0.0
+        # Retries are ours (typed errors, seeded jitter), so the SDK's own are off. timeout_s
+        # bounds each wait for a byte; the deadline the whole call.
         self.client = openai.OpenAI(
-            api_key=api_key, base_url=base_url, timeout=timeout_s, max_retries=0
+            api_key=api_key, base_url=base_url, max_retries=0,
+            http_client=_bounded_client(base_url, self._budget, self.limits, timeout_s),
         )
         self._format_mode = 0  # index into FORMAT_MODES, lowered when the server refuses one
         self._max_tokens_field = "max_tokens"
@@ -124,6 +320,7 @@ class OpenAIBackend(Backend):
 
     def complete(self, request: ChatRequest) -> Completion:
         structured = request.json_schema is not None
+        self._deadline = time.monotonic() + self.limits.deadline_s
         while True:
             mode = FORMAT_MODES[self._format_mode] if structured else "text"
             messages = request.messages
@@ -156,20 +353,31 @@ class OpenAIBackend(Backend):
             kwargs["response_format"] = fmt
 
         def attempt() -> Any:
+            self._budget.start(self._deadline, self.limits.max_response_bytes)
             try:
-                return self.client.chat.completions.create(**kwargs)
+                raw = self.client.chat.completions.with_raw_response.create(**kwargs)
             except openai.APITimeoutError as exc:
-                raise Transient("timed out") from exc
+                raise self._bounded(exc) or Transient("timed out") from exc
             except openai.APIConnectionError as exc:
                 cause = exc.__cause__
                 refused = cause is not None and type(cause).__name__ == "ConnectError"
-                raise Transient(f"connection failed ({cause or exc})", unreachable=refused) from exc
+                raise self._bounded(exc) or Transient(f"connection failed ({cause or exc})", unreachable=refused) from exc
             except openai.APIStatusError as exc:
                 raise self._classify(exc, format_requested=fmt is not None) from exc
             except (openai.APIResponseValidationError, json.JSONDecodeError) as exc:
                 raise Transient(f"malformed or truncated response body ({exc})") from exc
+            body = raw.http_response.content
+            if len(body) > self.limits.max_response_bytes:  # decompressed past the cap
+                raise _TooLarge(self._too_large())
+            try:
+                return parse_answer(body)
+            except ValueError as exc:
+                raise Transient(f"malformed or truncated response body: {exc}") from exc
 
-        outcome = run_with_retry(lambda: _checked(attempt()), self.retry, sleep=self._sleep)
+        try:
+            outcome = run_with_retry(attempt, self.retry, sleep=self._sleep, deadline=self._deadline)
+        except _TooLarge as exc:
+            raise ModelError(str(exc)) from None
         if isinstance(outcome, RetryOutcome):
             summary = "; ".join(outcome.errors)
             if outcome.unreachable:
@@ -177,13 +385,19 @@ class OpenAIBackend(Backend):
                     f"openai:{self.model_name}: nothing answers at {self.where} "
                     f"after {outcome.attempts} attempts ({summary})"
                 )
+            if outcome.deadline_passed:
+                raise TransientModelError(
+                    f"openai:{self.model_name} at {self.where}: no answer within the call's deadline of "
+                    f"{self.limits.deadline_s:g} s ({ENV_DEADLINE_S}) after {outcome.attempts} attempts: {summary}",
+                    attempts=outcome.attempts,
+                )
             raise TransientModelError(
                 f"openai:{self.model_name} at {self.where} failed {outcome.attempts} times: {summary}",
                 attempts=outcome.attempts,
             )
-        response, attempts = outcome
-        choice = response.choices[0]
-        usage = response.usage
+        answer, attempts = outcome
+        choice = answer.choices[0]
+        usage = answer.usage
         return Completion(
             text=choice.message.content or "",
             prompt_tokens=usage.prompt_tokens if usage else 0,
@@ -192,6 +406,18 @@ class OpenAIBackend(Backend):
             finish_reason=choice.finish_reason,
         )
 
+    def _bounded(self, exc: Exception) -> Exception | None:
+        """The error of an attempt our limits stopped (None: something else stopped it)."""
+        if self._budget.tripped == "size":
+            return _TooLarge(self._too_large())
+        if self._budget.tripped == "deadline" or time.monotonic() >= self._deadline:
+            return Transient(f"the {self.limits.deadline_s:g} s deadline passed", final=True)
+        return None
+
+    def _too_large(self) -> str:
+        return (f"openai:{self.model_name} at {self.where}: the answer is larger than the "
+                f"{self.limits.max_response_bytes} bytes cap ({ENV_MAX_BYTES}); not read further")
+
     def _classify(self, exc: openai.APIStatusError, *, format_requested: bool) -> Exception:
         code, detail = exc.status_code, _error_detail(exc)
         # Some servers answer an unknown response_format with 500 (llama-cpp-python's does):
@@ -199,7 +425,7 @@ class OpenAIBackend(Backend):
         if code in (400, 422) or (format_requested and "response_format" in detail):
             return _Refused(code, detail)
         if code in (408, 409, 425, 429) or code >= 500:
-            return Transient(f"HTTP {code}: {detail}")
+            return Transient(f"HTTP {code}: {detail}", retry_after=retry_after_s(exc.response.headers))
         where = f"openai:{self.model_name} at {self.where}: HTTP {code} {detail}"
         if code in (401, 403, 404):
             return ModelUnavailableError(where)
@@ -217,11 +443,8 @@ class _Refused(Exception):
         self.detail = detail
 
 
-def _checked(response: Any) -> Any:
-    # A body cut short may still parse as a JSON prefix object with no choices.
-    if not getattr(response, "choices", None):
-        raise Transient(f"response without choices: {str(response)[:200]}")
-    return response
+class _TooLarge(Exception):
+    """An answer past the size cap: not retried (the next would be as large)."""
 
 
 def _error_detail(exc: openai.APIStatusError) -> str:

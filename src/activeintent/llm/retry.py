@@ -15,9 +15,12 @@ R = TypeVar("R")
 class Transient(Exception):
     """Raised by a backend attempt that may succeed when tried again."""
 
-    def __init__(self, message: str, *, unreachable: bool = False) -> None:
+    def __init__(self, message: str, *, unreachable: bool = False, final: bool = False,
+                 retry_after: float | None = None) -> None:
         super().__init__(message)
         self.unreachable = unreachable  # nothing answered at all (connection refused)
+        self.final = final  # no use trying again (the call's deadline has passed)
+        self.retry_after = retry_after  # seconds the server asked us to wait (Retry-After)
 
 
 class RetryPolicy(BaseModel):
@@ -43,6 +46,7 @@ class RetryOutcome(BaseModel):
     attempts: int
     errors: list[str]
     unreachable: bool
+    deadline_passed: bool = False  # stopped early: no time left for another attempt
 
 
 def run_with_retry(
@@ -50,8 +54,14 @@ def run_with_retry(
     policy: RetryPolicy,
     *,
     sleep: Callable[[float], None] = time.sleep,
+    deadline: float | None = None,
+    clock: Callable[[], float] = time.monotonic,
 ) -> tuple[R, int] | RetryOutcome:
     """Call ``attempt`` until it returns or raises something other than :class:`Transient`.
+
+    A server's Retry-After is honoured when it is no longer than ``policy.max_delay_s`` and
+    fits before ``deadline`` (a ``clock`` time), else ignored; either way the error text says so.
+    No wait or attempt starts past ``deadline``.
 
     Returns ``(result, attempts)`` or, when every attempt was transient, a :class:`RetryOutcome`
     for the caller to turn into its typed error.
@@ -63,8 +73,24 @@ def run_with_retry(
         try:
             return attempt(), k + 1
         except Transient as exc:
-            errors.append(str(exc))
+            message = str(exc)
             unreachable = unreachable and exc.unreachable
-            if k < len(delays):
-                sleep(delays[k])
-    return RetryOutcome(attempts=policy.max_attempts, errors=errors, unreachable=unreachable)
+            if exc.final or k == len(delays):
+                errors.append(message)
+                return RetryOutcome(attempts=k + 1, errors=errors, unreachable=unreachable, deadline_passed=exc.final)
+            delay = delays[k]
+            left = None if deadline is None else deadline - clock()
+            if exc.retry_after is not None:
+                wanted = exc.retry_after
+                if wanted > policy.max_delay_s:
+                    message += f" (Retry-After {wanted:g} s ignored: longer than the {policy.max_delay_s:g} s longest wait)"
+                elif left is not None and wanted >= left:
+                    message += f" (Retry-After {wanted:g} s ignored: past the call's deadline)"
+                else:
+                    delay = max(delay, wanted)
+                    message += f" (Retry-After {wanted:g} s honoured)"
+            errors.append(message)
+            if left is not None and delay >= left:
+                return RetryOutcome(attempts=k + 1, errors=errors, unreachable=unreachable, deadline_passed=True)
+            sleep(delay)
+    raise AssertionError("unreachable: the last attempt returns above")
