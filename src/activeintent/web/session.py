@@ -21,7 +21,6 @@ Two study designs:
 from __future__ import annotations
 
 import json
-import os
 import re
 import secrets
 import threading
@@ -33,7 +32,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, Field, computed_field, model_validator
 
-from activeintent.records import EpisodeRecorder, dumps
+from activeintent.records import EpisodeRecorder
 from activeintent.users.human import (
     AnswerRejected,
     HumanUser,
@@ -42,6 +41,7 @@ from activeintent.users.human import (
     video_duration,
     video_frames,
 )
+from activeintent.web.basics import EstimateMode, write_json
 from activeintent.web.errors import ApiError
 
 SESSION_ID = re.compile(r"^[0-9a-f]{16}$")
@@ -53,8 +53,6 @@ Status = Literal["waiting-for-learner", "waiting-for-answer", "finished", "faile
 EpisodeBuilder = Callable[[int, Path, HumanUser, list[Any]], Any]
 
 
-EstimateMode = Literal["hidden", "after-answer", "always"]
-ESTIMATE_MODES: tuple[str, ...] = ("hidden", "after-answer", "always")
 Design = Literal["assigned-rule", "free-rule"]
 
 
@@ -219,13 +217,6 @@ def study_summary(summary: dict, config: StudyConfig) -> dict:
         tests=[{**t, "feasible": None, "success": None, "success_physics": None} for t in summary.get("tests", [])],
     )
     return out
-
-
-def write_json(path: Path, value: Any) -> None:
-    """Write strict JSON atomically (a reader never sees half a file)."""
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(json.dumps(json.loads(dumps(value)), indent=2))
-    os.replace(tmp, path)
 
 
 class StudyRecorder(EpisodeRecorder):

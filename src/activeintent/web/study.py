@@ -30,7 +30,7 @@ from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
-from activeintent.web.session import ESTIMATE_MODES, EstimateMode, write_json
+from activeintent.web.basics import ESTIMATE_MODES, EstimateMode, write_json
 
 # Participant IDs come from a link (Prolific and similar put 24 hex digits there): short, and
 # only characters that are safe in a file, a CSV cell and a URL.
