@@ -30,10 +30,12 @@ from pydantic import BaseModel, Field
 class RewardModel(BaseModel):
     """What the reward learners assume of people (no simulated user's parameter)."""
 
-    beta: float = Field(4.0, gt=0, description="β: rationality on reward differences (w on the unit sphere)")
+    # With w on the unit sphere one block changing one relation changes r by ~0.1–0.5, so β = 10
+    # makes a clear change a confident (≈ 99 %) choice and a small one close to a coin flip.
+    beta: float = Field(10.0, gt=0, description="β: rationality on reward differences (w on the unit sphere)")
     weak: float = Field(0.1, ge=0, description="δ: reward differences below this are hard to choose between")
     lapse: float = Field(0.05, ge=0, lt=1, description="λ: a uniformly random answer")
-    stop_beta: float = Field(4.0, gt=0, description="β of the choice among prefixes")
+    stop_beta: float = Field(10.0, gt=0, description="β of the choice among prefixes")
     stop_lapse: float = Field(0.05, ge=0, lt=1)
     delay_mean: float = Field(0.9, gt=0, description="s, reaction delay after a step's destination shows")
     delay_sd: float = Field(0.6, gt=0)
