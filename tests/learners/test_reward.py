@@ -13,6 +13,7 @@ from activeintent.learners.base import RoundRecord
 from activeintent.learners.registry import method_names
 from activeintent.learners.reward.features import FEATURE_NAMES, N_FEATURES, phi
 from activeintent.learners.reward.learner import RewardConfig, RewardLearner
+from activeintent.learners.reward.models import RewardObservation, preference_probs, prefix_probs
 from activeintent.records import read_rounds
 from activeintent.runner import RunOptions, build_episode
 from activeintent.signals import get_signal
@@ -72,15 +73,17 @@ def test_a_wrong_answer_does_not_collapse_the_belief():
     learner, rng = small_learner(1), np.random.default_rng(101)
     for k in range(20):
         ask(learner, rng, k, lambda t: exact_answer(w_true, t))
-    before = cosine(learner.belief.direction(), w_true)
-    # The most confident kind of mistake: the reverse of a clear preference.
-    ask(learner, rng, 20, lambda t: {"A": "B", "B": "A", "cant_choose": "A"}[exact_answer(w_true, t)])
-    assert before >= 0.9
-    assert cosine(learner.belief.direction(), w_true) >= 0.8
-    # No answer is impossible under any w: every particle keeps at least the lapse's share.
-    obs = learner.belief.obs[-1]
-    lik = np.exp(obs.log_lik(learner.belief.W, learner.reward_model))
-    assert lik.min() >= learner.reward_model.lapse / 3 * learner.reward_model.new_scene_error * 0.999
+    assert cosine(learner.belief.direction(), w_true) >= 0.9
+    # The most confident kind of mistake: "A" over an outcome B that the true reward rates far
+    # higher (r_B − r_A = 4), in a scene that can change what the reward values.
+    d = len(SUBSET)
+    learner.belief.update(RewardObservation("preference", np.stack([np.zeros(d), 4 * w_true]),
+                                            np.abs(w_true)[None], choice=0))
+    assert cosine(learner.belief.direction(), w_true) >= 0.9
+    # No answer is impossible under any w: each keeps at least the lapse's share.
+    m = learner.reward_model
+    assert preference_probs(np.zeros(3), np.array([1.0, 10.0, 1e3]), m)[:, 0].min() >= m.lapse / 3
+    assert prefix_probs(np.array([[0.0, 50.0, 100.0]]), m).min() >= m.stop_lapse / 3
 
 
 def test_the_feature_map_names_no_intention():
