@@ -49,6 +49,9 @@ METHOD_COLOURS = {
     "mllm-llm": _TAB20[12], "zero-signal": _TAB20[14],
 }
 _SPARE_COLOURS = tuple(c for c in _TAB20 if c not in METHOD_COLOURS.values())
+# The reward-learning peer (added later; the spare colours above, and so plug-ins' colours, stay as they were).
+METHOD_COLOURS.update({"reward-preference": _TAB20[16], "reward-preference-noplanner": _TAB20[17],
+                       "reward-stop": _TAB20[18], "reward-stop-noplanner": _TAB20[19]})
 
 
 def method_colour(method: str) -> str:

@@ -121,6 +121,22 @@ METHODS.register("lang-preference", lambda: _lang("preference"))
 METHODS.register("decide-stop", lambda: _lang("stop", "decide"))
 METHODS.register("decide-preference", lambda: _lang("preference", "decide"))
 
+def _reward(signal: str, planner: bool = True) -> Callable[[LearnerContext], Learner]:
+    def build(ctx: LearnerContext) -> Learner:
+        from activeintent.learners.reward.learner import RewardConfig, RewardLearner
+
+        return RewardLearner(signal, rng=ctx.seed, config=RewardConfig(planner=planner))
+
+    return build
+
+
+for _signal in ("preference", "stop"):
+    METHODS.register(f"reward-{_signal}", lambda s=_signal: Method(s, False, _reward(s), (
+        f"peer: APReL-style reward learning, w·φ(state) over 307 relation features, {s} queries by "
+        "mutual information (candidates include the Bayesian planner on its prior)"), "peer"))
+    METHODS.register(f"reward-{_signal}-noplanner", lambda s=_signal: Method(s, False, _reward(s, False), (
+        f"ablation of reward-{s}: candidates without the Bayesian planner"), "peer"))
+
 PAPER_METHODS = ("preference", "mllm", "mllm-llm")
 BASELINES = ("zero-signal", "random-query", "random-query-preference")
 

@@ -1,0 +1,1 @@
+"""Reward learning over state features (APReL-style): ``reward-preference``, ``reward-stop``."""
