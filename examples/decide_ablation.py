@@ -12,7 +12,9 @@
 - ``decide-shown-decision-gain-<signal>``: the decision gain without what the scene's
   feasibility tells (only the answers to the shown trajectories);
 - ``decide-needs-scenes-<signal>`` (a variant, not an ablation): each candidate scene also meets a
-  requirement drawn from the needs belief.
+  requirement drawn from the needs belief;
+- ``decide-chains-stop`` (a variant): stop queries may also show one likely goal's plan followed by
+  another's (``BayesConfig.chains = 4``).
 """
 
 from activeintent.learners.lang.learner import DECIDE, LangConfig, LangLearner
@@ -25,7 +27,9 @@ ABLATIONS = {
     "no-needs": {"needs": False},
     "shown-decision-gain": {"gain": "shown-decision"},
     "needs-scenes": {"scenes": "needs"},
+    "chains": {"chains": 4},
 }
+VARIANTS = ("needs-scenes", "chains")
 
 
 def _ablation(part: str, signal: str) -> Method:
@@ -37,10 +41,10 @@ def _ablation(part: str, signal: str) -> Method:
         learner.name = name
         return learner
 
-    kind = "variant" if part == "needs-scenes" else "ablation"
+    kind = "variant" if part in VARIANTS else "ablation"
     return Method(signal, False, build, f"{kind}: decide-{signal} with {ABLATIONS[part]}")
 
 
 for _part in ABLATIONS:
-    for _signal in ("stop", "preference"):
+    for _signal in ("stop",) if _part == "chains" else ("stop", "preference"):  # chains: stop queries only
         METHODS.register(f"decide-{_part}-{_signal}", lambda p=_part, s=_signal: _ablation(p, s))

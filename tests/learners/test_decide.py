@@ -122,6 +122,23 @@ def test_needs_scenes_meet_the_requirement_the_needs_belief_holds():
     assert red_share("needs") == 1.0 and red_share("belief") < 0.9  # belief keeps the 4 best of 16 draws
 
 
+def test_a_chained_plan_does_one_likely_goal_then_another():
+    from activeintent.learners.bayes.candidates import chained_plans, predict
+    from activeintent.learners.bayes.hypotheses import random_scene
+    from activeintent.world import WorldState, layout
+
+    space = LangSpace([parse_goal(k) for k in ["every colour:red in-bowl:any", "form tower:any all:"]])
+    rng = np.random.default_rng(1)
+    scene = next(s for s in (random_scene(rng) for _ in range(200))
+                 if "red block" in s.objects and len(s.blocks) >= 3 and all(h.feasible(s) for h in space.hypotheses))
+    state = WorldState(positions=layout(scene, 0))
+    red, tower = space.hypotheses
+    outs = chained_plans(space.hypotheses, np.array([0.6, 0.4]), state, np.ones(2, bool), first=2)
+    head = red.plan(state)
+    chain = next(o for o in outs if o.plan[:len(head)] == head)
+    assert len(chain.plan) > len(head) and chain.plan[len(head):] == tower.plan(predict(state, head).traj.outcome)
+
+
 def test_goals_that_agree_on_every_deployment_scene_share_a_class():
     keys = ["every colour:red in-bowl:any", "at-least-1 colour:red in-bowl:any", "none colour:red in-bowl:any"]
     space = LangSpace([parse_goal(k) for k in keys])
@@ -149,7 +166,7 @@ def _rounds(config: LangConfig, seed: int = 3) -> list[tuple]:
 
 
 @pytest.mark.parametrize("switch", [{"scenes": "random"}, {"scenes": "needs"}, {"gain": "goal"}, {"gain": "shown"},
-                                    {"gain": "shown-decision"}, {"needs": False}])
+                                    {"gain": "shown-decision"}, {"needs": False}, {"chains": 4}])
 def test_every_switch_changes_the_questions(switch):
     assert _rounds(LangConfig(**{**DECIDE, **switch})) != _rounds(LangConfig(**DECIDE))
 

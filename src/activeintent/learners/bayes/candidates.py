@@ -70,3 +70,38 @@ def candidate_plans(
         if len(outs) >= limit:
             break
     return outs[:limit]
+
+
+def chained_plans(
+    hyps: tuple[Hypothesis, ...],
+    weights: np.ndarray,
+    state: WorldState,
+    feasible: np.ndarray,
+    first: int = 4,
+    limit: int = 8,
+    seen: set[tuple] | None = None,
+) -> list[Outcome]:
+    """Longer plans for a stop query: the plan of one of the ``first`` most probable feasible
+    hypotheses z_i, then from where it ends the plan of another of them z_j. Where the person
+    stops (in the first part, the second, or not at all) then tells the likely goals apart by
+    *when*, not only whether. ``seen``: outcome keys already offered (not repeated)."""
+    order = ranking.order(weights, ranking.WEIGHT_DECIMALS)
+    top = order[feasible[order]][:first].tolist()
+    seen = set(seen or ()) | {state_key(facts(state))}
+    outs: list[Outcome] = []
+    for i in top:
+        head = hyps[i].plan(state)
+        if not head:
+            continue
+        middle = predict(state, head).traj.outcome
+        for j in top:
+            tail = hyps[j].plan(middle) if j != i else None
+            if not tail:
+                continue
+            o = predict(state, head + tail)
+            if o.key not in seen:
+                seen.add(o.key)
+                outs.append(o)
+            if len(outs) >= limit:
+                return outs
+    return outs

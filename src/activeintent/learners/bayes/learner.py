@@ -28,7 +28,7 @@ from activeintent import ranking
 from activeintent.learners.base import Estimate, Learner, RoundRecord
 from activeintent.learners.bayes.acquisition import Query, particles, select_query
 from activeintent.learners.bayes.belief import Belief, Prior
-from activeintent.learners.bayes.candidates import candidate_plans, predict
+from activeintent.learners.bayes.candidates import candidate_plans, chained_plans, predict
 from activeintent.learners.bayes.decision import decision_classes, deployment_states
 from activeintent.learners.bayes.facts import facts
 from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space, random_scene
@@ -77,6 +77,8 @@ class BayesConfig(BaseModel):
     deploy_scenes: int = Field(8, ge=1, description="gain = decision: the learner's own scenes of the test distribution")
     needs: bool = Field(False, description="also learn what the intention needs of a scene's objects from "
                         "'new scene' answers (needs.py)")
+    chains: int = Field(0, ge=0, description="stop queries: also offer plans of one of this many likely z "
+                        "followed by another's (candidates.chained_plans); 0: none")
     top_k: int = Field(16, ge=1, description="plans come from this many most probable hypotheses")
     explore: int = Field(6, ge=0, description="... plus this many random other hypotheses")
     max_plans: int = Field(36, ge=2, description="candidate plans per scene")
@@ -190,6 +192,10 @@ class BayesLearner(Learner):
         outs = candidate_plans(self.hyps, self.weights, state, self.rng, top_k=c.top_k, explore=c.explore,
                                prefixes=self.sig.shows > 1, limit=c.max_plans, feasible=feasible)
         feasible = self.judge.feasible(tuple(state.positions))  # the planner may have found some z infeasible
+        if c.chains and self.sig.shows == 1:
+            outs += chained_plans(self.hyps, self.weights, state, feasible, first=c.chains,
+                                  seen={o.key for o in outs})
+            feasible = self.judge.feasible(tuple(state.positions))
         return select_query(self.sig, self.model, self.judge, self.weights, feasible, outs,
                             c.new_scene_error, self.rng, choose=c.choose, gain=c.gain,
                             classes=self.decision_classes() if c.gain.endswith("decision") else None,
