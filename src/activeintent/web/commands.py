@@ -22,6 +22,9 @@ class ShowEstimate(StrEnum):
 def register(app: typer.Typer) -> None:
     app.command(name="serve")(serve)
     app.command(name="study-export")(study_export)
+    from activeintent.web.wait_bench import web_bench
+
+    app.command(name="web-bench")(web_bench)
 
 
 def serve(

@@ -1,0 +1,114 @@
+"""`activeintent web-bench`: how long a participant waits between rounds of the web study.
+
+The wait is what a person sits through after an answer before the next round's videos can be
+played: the learner's update and next query, the physics run and the video export. It is
+measured on the real app (FastAPI with its sessions, episodes and PyBullet, in process, through
+a test client), answering every round at once, so the figures are the server's part of the wait
+(a browser adds the download of the videos). The first round's wait, from the start of the
+session, includes loading the simulator and is reported apart.
+"""
+
+from __future__ import annotations
+
+import json
+import tempfile
+import time
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+
+from activeintent import options as opt
+from activeintent.options import D
+
+POLL_S = 0.02
+READY = ("waiting-for-answer", "finished", "failed", "cancelled")
+
+
+def _answer(signal: str, round_: int) -> dict:
+    if signal == "preference":
+        return {"kind": "preference", "round": round_, "choice": "A"}
+    return {"kind": "stop", "round": round_, "action": "looks_good"}
+
+
+def measure_waits(method: str, rounds: int, video_size: int, seed: int, out: Path,
+                  intention: str | None = None, timeout_s: float = 900.0) -> dict:
+    """Seconds from each answer until the next round (or the end) is ready, for one session."""
+    from fastapi.testclient import TestClient
+
+    from activeintent.learners.registry import get_method
+    from activeintent.web.server import create_app, runner_builder
+    from activeintent.web.session import StudyConfig
+
+    config = StudyConfig(method=method, signal=get_method(method).signal, rounds=rounds, out_dir=out,
+                         intention=intention, video_size=(video_size, video_size))
+    app = create_app(config, runner_builder(config, llm="none"))
+    waits: list[float] = []
+    with TestClient(app) as client:
+        start = time.perf_counter()
+        sid = client.post("/api/sessions", json={"seed": seed, "consent": True}).json()["id"]
+
+        def ready(after: int) -> dict:
+            deadline = time.perf_counter() + timeout_s
+            while time.perf_counter() < deadline:
+                state = client.get(f"/api/sessions/{sid}").json()
+                q = state.get("question")
+                if state["status"] in READY[1:] or (q is not None and q["round"] > after):
+                    return state
+                time.sleep(POLL_S)
+            raise TimeoutError(f"the session did not get ready within {timeout_s:.0f} s")
+
+        state = ready(0)
+        first = time.perf_counter() - start
+        while state["status"] == "waiting-for-answer":
+            r = state["question"]["round"]
+            sent = time.perf_counter()
+            got = client.post(f"/api/sessions/{sid}/answer", json=_answer(config.signal, r))
+            if got.status_code != 200:
+                raise RuntimeError(f"the app refused the answer to round {r}: {got.text[:300]}")
+            state = ready(r)
+            if state["status"] == "waiting-for-answer":
+                waits.append(time.perf_counter() - sent)
+        if state["status"] != "finished":
+            raise RuntimeError(f"the session ended {state['status']}")
+    w = np.array(waits)
+    return {"method": method, "signal": config.signal, "rounds": rounds, "video_px": video_size,
+            "first_round_s": round(first, 2), "waits_s": [round(x, 2) for x in waits],
+            "p50_s": round(float(np.percentile(w, 50)), 2) if len(w) else None,
+            "p90_s": round(float(np.percentile(w, 90)), 2) if len(w) else None,
+            "target_p90_s": 3.0}
+
+
+def web_bench(
+    method: Annotated[str, typer.Option("--method", help="A method of the web study (see `activeintent methods`)")] = "bayes-stop",
+    rounds: Annotated[int, typer.Option("--rounds", min=2, max=30, help="Rounds of the session (waits: rounds − 1)")] = 5,
+    video_size: Annotated[int, typer.Option("--video-size", min=64, max=1024, help="Video width and height in pixels")] = 480,
+    sessions: Annotated[int, typer.Option("--sessions", min=1, max=20, help="Sessions, one after another (seeds 0, 1, …)")] = 2,
+    intention: Annotated[str | None, typer.Option("--intention", help="An assigned rule (default: free rule)")] = None,
+    seed: opt.Seed = D.seed,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON only")] = False,
+) -> None:
+    """Measure the wait between rounds of the web study (p50 / p90; target p90 ≤ 3 s at 480 px)."""
+    from rich.console import Console
+
+    console = Console(stderr=as_json)
+    results = []
+    with tempfile.TemporaryDirectory(prefix="web-bench-") as tmp:
+        for n in range(sessions):
+            console.print(f"session {n + 1}/{sessions}: {method}, {rounds} rounds, {video_size} px …")
+            try:
+                results.append(measure_waits(method, rounds, video_size, seed + n, Path(tmp) / f"s{n}", intention))
+            except (ValueError, RuntimeError, TimeoutError) as err:
+                console.print(f"[red]error:[/red] {err}")
+                raise typer.Exit(2) from None
+    waits = np.array([w for r in results for w in r["waits_s"]])
+    summary = {"method": method, "video_px": video_size, "sessions": sessions, "waits": len(waits),
+               "p50_s": round(float(np.percentile(waits, 50)), 2), "p90_s": round(float(np.percentile(waits, 90)), 2),
+               "first_round_s": [r["first_round_s"] for r in results], "target_p90_s": 3.0, "per_session": results}
+    if as_json:
+        print(json.dumps(summary))
+        return
+    console.print(f"between-round wait, {method} at {video_size} px: p50 {summary['p50_s']:.2f} s, "
+                  f"p90 {summary['p90_s']:.2f} s over {len(waits)} waits (target p90 ≤ 3 s); first round "
+                  f"{', '.join(f'{x:.1f}' for x in summary['first_round_s'])} s (simulator start included)")
