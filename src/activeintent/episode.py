@@ -276,6 +276,7 @@ class Episode:
         physics = final and self.env.name != "symbolic"
         # The final attempt shown (final.gif, the web's final video) is on a scene that can show
         # the intention: the same scene final_z comes from (a web study may ask for the first).
+        # Asking feasibility before the learner answers is safe: the learner never sees it.
         shown = (self._final_shown_index(tests) if self.show_final else first_feasible(self.intention, tests)) \
             if physics else None
         logs = []
