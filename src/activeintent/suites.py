@@ -1,12 +1,16 @@
 """Benchmark suites of hidden intentions: ``paper`` (the paper's four), ``library`` (the other
 built-in intentions), ``heldout`` (written blind, before any learner change, in
-``bench/heldout.py``; reported separately), ``dev`` (``bench/dev.py``: for tuning learners) and
+``bench/heldout.py``; reported separately), ``heldout2`` (a second held-out suite, ``h2-…``,
+written blind with the world's helpers only, in ``intentions/suites/heldout2.py``; reported
+separately, like ``heldout``), ``dev`` (``bench/dev.py``: for tuning learners) and
 ``truth-goals`` (``truth-00`` … ``truth-49``: 50 goals of the goal language drawn at random and
 committed as data, ``bench/truth_goals.json``; learning efficiency apart from coverage).
 Names of every suite resolve everywhere an intention name is accepted.
 """
 
 from __future__ import annotations
+
+import functools
 
 from activeintent.intentions.base import Intention
 from activeintent.intentions.registry import (
@@ -17,13 +21,24 @@ from activeintent.intentions.registry import (
     resolve_intention,
 )
 
-SUITE_NAMES = ("paper", "library", "heldout", "dev", "truth-goals")
+SUITE_NAMES = ("paper", "library", "heldout", "heldout2", "dev", "truth-goals")
 
 
 def _heldout() -> dict[str, Intention]:
     from activeintent.bench.heldout import heldout_intentions
 
     return {it.name: it for it in heldout_intentions()}
+
+
+def _heldout2() -> dict[str, Intention]:
+    from activeintent.intentions.suites.heldout2 import heldout2_intentions
+
+    return {it.name: it for it in heldout2_intentions()}
+
+
+@functools.cache
+def _heldout2_names() -> frozenset[str]:
+    return frozenset(_heldout2())
 
 
 def _dev() -> dict[str, Intention]:
@@ -52,6 +67,8 @@ def suite(name: str) -> list[str]:
         return [n for n in INTENTION_NAMES if n not in PAPER_INTENTIONS]
     if name == "heldout":
         return list(_heldout())
+    if name == "heldout2":
+        return list(_heldout2())
     if name == "dev":
         return list(_dev())
     if name == "truth-goals":
@@ -69,6 +86,8 @@ def suite_of(intention: str) -> str:
         return "library"
     if intention.startswith("truth-") and intention in _truth_names():
         return "truth-goals"
+    if intention in _heldout2_names():
+        return "heldout2"
     return "dev" if intention in _dev() else "heldout"
 
 
@@ -81,6 +100,9 @@ def resolve(name: str | None, intention_file: str | None = None) -> Intention:
         held = _heldout()
         if name in held:
             return held[name]
+        held2 = _heldout2()
+        if name in held2:
+            return held2[name]
         truth = _truth()
         if name in truth:
             return truth[name]
@@ -88,7 +110,8 @@ def resolve(name: str | None, intention_file: str | None = None) -> Intention:
             return get_intention(name)
         except IntentionError as err:
             raise IntentionError(
-                f"{err} Held-out intentions: {', '.join(held)}. Dev intentions: {', '.join(dev)}. "
+                f"{err} Held-out intentions: {', '.join(held)}. Held-out-2 intentions: "
+                f"{', '.join(held2)}. Dev intentions: {', '.join(dev)}. "
                 f"Truth-goal intentions: {_truth_names()[0]} … {_truth_names()[-1]}."
             ) from None
     return resolve_intention(name, intention_file)

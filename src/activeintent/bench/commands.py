@@ -40,7 +40,7 @@ def _apply_preset(preset: str, methods: str, intentions: str, budget: int) -> tu
 
 def bench(
     methods: Annotated[str, typer.Option("--methods", help="Comma-separated methods (default: bayes-preference, bayes-stop and the baselines)")] = "",
-    suite: Annotated[str | None, typer.Option("--suite", help="Comma-separated suites: paper, library, heldout, dev, truth-goals (default: paper, unless --intentions or --intention-file name what to run)")] = None,
+    suite: Annotated[str | None, typer.Option("--suite", help="Comma-separated suites: paper, library, heldout, heldout2, dev, truth-goals (default: paper, unless --intentions or --intention-file name what to run)")] = None,
     intentions: Annotated[str, typer.Option("--intentions", help="Comma-separated intentions (instead of --suite)")] = "",
     intention_file: Annotated[list[str] | None, typer.Option("--intention-file", help="Your own: path.py:NAME (repeatable); alone it runs just these, with --suite or --intentions it adds them")] = None,
     plugin: opt.Plugin = None,

@@ -1,0 +1,1 @@
+"""Benchmark suites of hidden intentions written as modules of their own (``heldout2``, ...)."""
