@@ -22,6 +22,7 @@ from activeintent.intentions.registry import (
 )
 
 SUITE_NAMES = ("paper", "library", "heldout", "heldout2", "dev", "truth-goals")
+HELDOUT_SUITES = ("heldout", "heldout2")  # written blind; never tuned on; per intention only after a freeze
 
 
 def _heldout() -> dict[str, Intention]:

@@ -13,6 +13,7 @@ from activeintent.options import D
 
 def register(app: typer.Typer) -> None:
     app.command(name="bench")(bench)
+    app.command(name="coverage")(coverage)
 
 
 def _split(text: str) -> list[str]:
@@ -215,3 +216,71 @@ def _run_with_progress_bar(console, options, out: Path, names: dict[str, str]) -
                 progress.update(task, completed=finished)
 
         return run_bench(options, out, on_done, _RejectedLines(progress.console))
+
+
+def coverage(
+    suite: Annotated[str, typer.Option("--suite", help="Comma-separated suites: paper, library, heldout, heldout2, dev, truth-goals")] = "",
+    intentions: Annotated[str, typer.Option("--intentions", help="Comma-separated intentions (instead of --suite)")] = "",
+    intention_file: Annotated[list[str] | None, typer.Option("--intention-file", help="Your own: path.py:NAME (repeatable)")] = None,
+    plugin: opt.Plugin = None,
+    seed: opt.Seed = D.seed,
+    scenes: Annotated[int, typer.Option("--scenes", min=5, help="Scenes on which the best goal is chosen")] = 30,
+    test_scenes: Annotated[int, typer.Option("--test-scenes", min=10, help="Further scenes on which its plan success is reported")] = 100,
+    after_freeze: Annotated[bool, typer.Option("--after-freeze", help="Also print held-out intentions one by one (only after a freeze commit: docs/protocol.md)")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="print JSON")] = False,
+    out: Annotated[Path | None, typer.Option("--out", help="Also write the table as JSON here")] = None,
+) -> None:
+    """How well the goal language can say each intention: its best goal by behaviour (the goal
+    whose own plan satisfies the intention on most test scenes), that plan's success — the
+    oracle, the ceiling of every lang-* / decide-* learner — its description length, prior rank
+    and whether the learner starts with it."""
+    import json
+
+    from rich.console import Console
+    from rich.markup import escape
+    from rich.table import Table
+
+    from activeintent.bench.coverage import EXPRESSIBLE, coverage_table
+    from activeintent.progress_lines import print_line
+    from activeintent.suites import HELDOUT_SUITES, resolve, suite_of
+    from activeintent.suites import suite as suite_names
+
+    console = Console()
+    try:
+        from activeintent.registry import load_plugin
+
+        for path in plugin or []:
+            load_plugin(path)
+        names = _split(intentions) or [i for s in _split(suite) for i in suite_names(s)]
+        items = [resolve(n) for n in names] + [resolve(None, f) for f in intention_file or []]
+        if not items:
+            raise ValueError("nothing to measure: give --suite, --intentions or --intention-file")
+    except (ValueError, FileNotFoundError) as err:
+        console.print(f"[red]error:[/red] {err}")
+        raise typer.Exit(2) from None
+    groups = [suite_of(n) for n in names] + ["file"] * len(intention_file or [])
+    table = coverage_table(items, groups, seed=seed, scenes=scenes, test_scenes=test_scenes,
+                           progress=lambda text: print_line(console, escape(text)) if not as_json else None)
+    if not after_freeze:  # per-intention rows of a held-out suite are the reading its rule forbids
+        table["intentions"] = [r for r in table["intentions"] if r["suite"] not in HELDOUT_SUITES]
+    if out is not None:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(json.dumps(table, indent=2, ensure_ascii=False))
+    if as_json:
+        typer.echo(json.dumps(table, indent=2, ensure_ascii=False))
+        return
+    rows = Table("intention", "oracle", "best goal z*", "L(z*)", "prior rank", "start space", title=(
+        f"Coverage: plan success of the best goal on {test_scenes} feasible test scenes (chosen on {scenes} others)"))
+    for r in table["intentions"]:
+        mark = "" if r["success"] >= EXPRESSIBLE else " [yellow](not expressible)[/yellow]"
+        rows.add_row(escape(r["intention"]), f"{r['success']:.2f}{mark}", escape(r["goal"]), f"{r['bits']:.1f}",
+                     str(r["prior_rank"]), "yes" if r["in_start_space"] else "no")
+    console.print(rows)
+    for s in table["suites"]:
+        console.print(f"[bold]{escape(s['suite'])}[/bold]: oracle mean {s['mean']:.2f} over {s['n']} intentions "
+                      f"(95 % bootstrap interval {s['ci'][0]:.2f}–{s['ci'][1]:.2f}); {s['expressible']} of {s['n']} "
+                      f"≥ {EXPRESSIBLE}; median L(z*) {s['median_bits']:.1f} bits; {s['in_start_space']} in the start space",
+                      highlight=False)
+    hidden = sorted({g for g in groups if g in HELDOUT_SUITES})
+    if hidden and not after_freeze:
+        console.print(f"(per-intention rows of {', '.join(hidden)} not shown: held out; --after-freeze shows them)")

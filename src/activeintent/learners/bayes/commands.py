@@ -15,7 +15,8 @@ def register(app: typer.Typer) -> None:
         examples: Annotated[int, typer.Option(min=0, help="how many example hypotheses to list")] = 15,
         as_json: Annotated[bool, typer.Option("--json", help="print JSON instead of a table")] = False,
         explain: Annotated[str | None, typer.Option(
-            "--explain", help="how a sentence is expressed in the goal language of lang-* (or that it is not)")] = None,
+            "--explain", help="an intention (name or path.py:NAME): its best goal of the language by behaviour and "
+            "whether it is expressible; a sentence: the goals whose sentences share its words")] = None,
         language: Annotated[bool, typer.Option(
             "--language", help="the goal language of lang-*: node types, counts, examples")] = False,
     ) -> None:
@@ -23,10 +24,9 @@ def register(app: typer.Typer) -> None:
         import numpy as np
 
         if explain is not None or language:
-            from activeintent.learners.lang.explain import explain as explain_sentence
             from activeintent.learners.lang.explain import language_summary
 
-            out = explain_sentence(explain) if explain is not None else language_summary(examples)
+            out = _explained(explain) if explain is not None else language_summary(examples)
             typer.echo(json.dumps(out, indent=2, ensure_ascii=False) if as_json else _lang_text(out))
             return
 
@@ -95,6 +95,29 @@ def register(app: typer.Typer) -> None:
         from rich.console import Console
 
         Console().print_json(json.dumps(result))
+
+
+def _explained(text: str) -> dict:
+    """By behaviour for an intention's name or path.py:NAME, by words for a sentence."""
+    from activeintent.intentions.registry import IntentionError
+    from activeintent.learners.lang.explain import explain as explain_sentence
+    from activeintent.learners.lang.explain import explain_intention
+    from activeintent.suites import HELDOUT_SUITES, resolve, suite_of
+
+    name = text.strip()
+    looks_like_name = ".py:" in name or (" " not in name and len(name) < 80)
+    if not looks_like_name:
+        return explain_sentence(text)
+    try:
+        intention = resolve(None, name) if ".py:" in name else resolve(name)
+    except (IntentionError, ValueError, FileNotFoundError) as err:
+        if ".py:" in name:
+            raise typer.BadParameter(str(err)) from None
+        return explain_sentence(text)
+    if suite_of(name) in HELDOUT_SUITES:
+        raise typer.BadParameter(f"{name!r} is held out: its coverage is reported only as the suite's mean "
+                                 "(activeintent coverage --suite ...; per intention only after a freeze)")
+    return explain_intention(intention)
 
 
 def _lang_text(out: dict) -> str:

@@ -1,10 +1,12 @@
-"""From an English sentence to the closest goals of the language (``hypotheses --explain``),
-and a summary of the language (``hypotheses --language``).
+"""From an English sentence to the closest goals of the language by words (``hypotheses
+--explain "…"``), and a summary of the language (``hypotheses --language``).
 
-The matcher is deliberately simple: words are normalised (plurals, a few synonyms), every
-one-clause goal's sentence is compared with the request by weighted word overlap, and a
-request made of two parts ("…, and …") is also matched as a pair of clauses. A best match
-below ``MIN_SCORE`` means the language has no goal for the sentence.
+Words are not behaviour: "the red block on the blue block" and its reverse share every word.
+The matcher is only a lookup — words are normalised (plurals, a few synonyms), every one-clause
+goal's sentence is compared with the request by weighted word overlap, and a two-part request
+("…, and …") is also matched as a pair of clauses. Whether the language can *say* an intention
+is measured on its checker by ``bench/coverage.py`` (``--explain`` given an intention's name or
+``path.py:NAME`` uses that).
 """
 
 from __future__ import annotations
@@ -14,7 +16,9 @@ import re
 from collections import Counter
 from functools import lru_cache
 
-from activeintent.learners.lang.expr import NODES, QUANTS, Goal, all_clauses
+from activeintent.learners.lang.expr import NODES, QUANTS, Goal, all_clauses, parse_goal
+
+SELECTION = 30  # bench.coverage.SELECTION_SCENES (not imported here: the lookup stays light)
 
 MIN_SCORE = 0.45
 STOP = {"the", "a", "an", "is", "are", "be", "should", "to", "of", "on", "in", "and", "it", "its", "their",
@@ -87,9 +91,27 @@ def explain(sentence: str, n: int = 5) -> dict:
     rows = [{"score": round(s, 3), "key": g.key, "bits": round(g.bits, 2), "sentence": g.sentence()}
             for s, g in found[:n]]
     ok = bool(rows) and rows[0]["score"] >= MIN_SCORE
-    return {"sentence": sentence, "expressible": ok, "matches": rows,
-            "note": "closest goal of the language" if ok else
-            "no goal of the language matches this sentence well; the closest ones are listed"}
+    return {"sentence": sentence, "lexical_match": ok, "matches": rows,
+            "note": ("goals whose sentences share the request's words (a lookup by words, not a test: "
+                     "give an intention name or path.py:NAME to measure whether a goal does what it asks)"
+                     if ok else "no goal's sentence shares the request's words; the closest ones are listed")}
+
+
+def explain_intention(intention, seed: int = 0) -> dict:
+    """The best goal of the language for an intention, by behaviour (bench/coverage.py), and
+    the verdict: expressible when its plan satisfies the intention on ≥ EXPRESSIBLE of the scenes."""
+    from activeintent.bench.coverage import EXPRESSIBLE, coverage, start_space_keys
+
+    c = coverage(intention, seed=seed, start_keys=start_space_keys())
+    ok = c.success >= EXPRESSIBLE
+    verdict = "expressible" if ok else f"not expressible (best: {c.sentence!r}, {c.success:.2f})"
+    rows = [{"score": c.success, "key": c.goal, "bits": c.bits, "sentence": c.sentence}]
+    rows += [{"score": r["selection_success"], "key": r["goal"], "bits": r["bits"],
+              "sentence": parse_goal(r["goal"]).sentence()} for r in c.runner_up]
+    return {"sentence": intention.description, "intention": intention.name, "expressible": ok,
+            "note": f"{verdict}: plan success of its best goal on {c.test_scenes} feasible test scenes "
+                    f"(threshold {EXPRESSIBLE}; runners-up: success on the {SELECTION} selection scenes)",
+            "matches": rows, "prior_rank": c.prior_rank, "in_start_space": c.in_start_space}
 
 
 def language_summary(examples: int = 12) -> dict:

@@ -1,0 +1,140 @@
+"""Coverage (bench/coverage.py, `activeintent coverage`, `hypotheses --explain NAME`): the best
+goal by behaviour is found for an intention that is a goal, in the right direction; an intention
+outside the language is called not expressible; the prior rank counts what it says; held-out
+rows stay hidden before a freeze."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from activeintent.bench import coverage as cov
+from activeintent.intentions.base import Intention
+from activeintent.learners.bayes.facts import facts
+from activeintent.learners.lang.expr import MAX_CLAUSES, parse_goal
+from activeintent.learners.lang.hypotheses import GoalIntention
+from activeintent.world import PutAt, WorldState, apply_skill
+from activeintent.world.scene import sample_scene
+
+STRIP_X = 0.17  # no region of the language has an edge near here
+
+
+class OnAStrip(Intention):
+    """Every block on the table within 2 cm of the line x = 0.17: outside the language."""
+
+    name = "test-on-a-strip"
+    description = "Put every block on the table within 2 cm of the line x = 0.17."
+
+    def satisfied(self, state):
+        f = facts(state)
+        return all(f.below[b] is None and f.bowl_of[b] is None and abs(f.xy[b][0] - STRIP_X) < 0.02
+                   for b in state.blocks)
+
+    def score(self, state):
+        f = facts(state)
+        return float(np.mean([abs(f.xy[b][0] - STRIP_X) < 0.02 for b in state.blocks]))
+
+    def feasible(self, scene):
+        return True
+
+    def sample_scene(self, rng):
+        return sample_scene(rng, n_blocks=(2, 3), n_bowls=1)
+
+    def plan(self, state):
+        steps = []
+        spots = iter(np.linspace(-0.25, -0.75, 11))
+        for b in state.blocks:
+            for y in spots:
+                new, fail = apply_skill(state, PutAt(block=b, position=(STRIP_X, float(y))))
+                if fail is None:
+                    steps.append(PutAt(block=b, position=(STRIP_X, float(y))))
+                    state = new
+                    break
+            else:
+                return None
+        return steps
+
+
+def test_an_intention_that_is_a_goal_is_covered_by_it_with_plan_success_one():
+    goal = parse_goal("every all: in-bowl:same")
+    got = cov.coverage(GoalIntention(goal), scenes=12, test_scenes=30)
+    assert got.success == 1.0 and got.selection_success == 1.0
+    assert got.bits <= goal.bits + 1e-9  # the same goal, or one as short that behaves as well
+
+
+def test_coverage_is_direction_sensitive():
+    got = cov.coverage(GoalIntention(parse_goal("every colour:red on-the-block:blue")), scenes=10, test_scenes=20)
+    assert got.success >= 0.95
+    assert "colour:blue on-the-block:red" not in got.goal
+
+
+def test_an_intention_outside_the_language_is_not_expressible():
+    from activeintent.learners.lang.explain import explain_intention
+
+    got = cov.coverage(OnAStrip(), scenes=10, test_scenes=20)
+    assert got.success < cov.EXPRESSIBLE
+    said = explain_intention(OnAStrip())
+    assert not said["expressible"] and said["note"].startswith("not expressible (best: ")
+
+
+def test_the_prior_rank_counts_the_goals_with_fewer_bits():
+    rng = np.random.default_rng(3)
+    singles = np.round(rng.uniform(5, 12, 40), 1)
+    base = math.log2(MAX_CLAUSES) + 1
+    goals = [base + b for b in singles for _ in (0, 1)]  # with and without "stays"
+    goals += [base + a + b - 1 for a, b in itertools.combinations(singles, 2) for _ in (0, 1)]
+    for bits in (base + 5.5, base + 9.0, base + 14.3, base + 20.0):
+        assert cov._rank(bits, singles) == 1 + sum(g < bits - 1e-9 for g in goals)
+
+
+def test_feasible_scenes_are_seeded_and_feasible():
+    it = GoalIntention(parse_goal("every all: in-bowl:same"))
+    a = cov.feasible_scenes(it, 8, 0, "selection")
+    assert a == cov.feasible_scenes(it, 8, 0, "selection")
+    assert a != cov.feasible_scenes(it, 8, 0, "test")
+    assert all(it.feasible(scene) for scene, _ in a)
+
+
+def test_the_plan_success_is_judged_by_the_intention_on_the_plans_end_state():
+    it = OnAStrip()
+    scenes = cov.feasible_scenes(it, 6, 0, "selection")
+    rate, finals = cov.goal_success(parse_goal("every all: region:right half"), scenes, it)
+    ends = {k: e for k, e in finals}
+    assert rate == sum(it.satisfied(e) for e in ends.values()) / len(scenes)
+    assert all(isinstance(e, WorldState) for e in ends.values())
+
+
+@pytest.fixture
+def fake_table(monkeypatch):
+    def table(items, groups, **kw):
+        rows = [{"suite": g, "intention": it.name, "success": 0.5, "goal": "form tower:any all:", "bits": 9.8,
+                 "sentence": "s", "prior_rank": 13, "in_start_space": True} for it, g in zip(items, groups, strict=True)]
+        return {"protocol": {}, "intentions": rows,
+                "suites": [{"suite": g, "n": 1, "mean": 0.5, "ci": [0.5, 0.5], "expressible": 0, "median_bits": 9.8,
+                            "in_start_space": 1} for g in dict.fromkeys(groups)]}
+
+    monkeypatch.setattr(cov, "coverage_table", table)
+
+
+def test_the_command_hides_held_out_rows_before_a_freeze(fake_table):
+    from activeintent.cli import app
+    from activeintent.suites import suite
+
+    held, dev = suite("heldout")[0], suite("dev")[0]
+    out = CliRunner().invoke(app, ["coverage", "--intentions", f"{held},{dev}"], env={"COLUMNS": "200"})
+    assert out.exit_code == 0, out.output
+    assert dev in out.output and held not in out.output and "held out" in out.output
+    out = CliRunner().invoke(app, ["coverage", "--intentions", f"{held},{dev}", "--after-freeze"],
+                             env={"COLUMNS": "200"})
+    assert held in out.output
+
+
+def test_an_unknown_intention_is_a_clear_error():
+    from activeintent.cli import app
+
+    out = CliRunner().invoke(app, ["coverage", "--intentions", "no-such-thing"])
+    assert out.exit_code == 2 and "Unknown intention" in out.output
