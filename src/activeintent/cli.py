@@ -34,7 +34,7 @@ for _module in _COMMAND_MODULES:
 
 # Commands that only measure or demonstrate: in check-only mode their options are parsed and
 # nothing runs (run, bench and serve validate deeper themselves).
-_MEASURING = {"sim-demo", "sim-bench", "model-bench", "act-bench", "bayes-bench", "perf-bench", "bench-verify"}
+_MEASURING = {"coverage", "sim-demo", "sim-bench", "model-bench", "act-bench", "bayes-bench", "perf-bench", "bench-verify"}
 
 
 def _checked(callback):

@@ -73,7 +73,7 @@ def test_coverage_is_direction_sensitive():
 
 
 def test_an_intention_outside_the_language_is_not_expressible():
-    from activeintent.learners.lang.explain import explain_intention
+    from activeintent.bench.coverage import explain_intention
 
     got = cov.coverage(OnAStrip(), scenes=10, test_scenes=20)
     assert got.success < cov.EXPRESSIBLE

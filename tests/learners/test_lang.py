@@ -154,10 +154,10 @@ def test_explain_finds_the_goal_of_a_sentence():
     from activeintent.learners.lang.explain import explain
 
     got = explain("Stack all the blocks into a single tower.")
-    assert got["expressible"] and got["matches"][0]["key"] == "form tower:any all:"
+    assert got["lexical_match"] and got["matches"][0]["key"] == "form tower:any all:"
     got = explain("Put every block in the bowl of its own colour")
     assert got["matches"][0]["key"] == "every all: in-bowl:same"
-    assert not explain("Juggle while singing loudly")["expressible"]
+    assert not explain("Juggle while singing loudly")["lexical_match"]
 
 
 def test_every_sampled_goal_of_the_space_gets_a_plan_wherever_it_is_called_feasible():

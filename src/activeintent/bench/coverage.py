@@ -39,7 +39,7 @@ import numpy as np
 
 from activeintent.intentions.base import Intention
 from activeintent.learners.bayes.facts import facts
-from activeintent.learners.lang.expr import MAX_CLAUSES, Goal, all_clauses
+from activeintent.learners.lang.expr import MAX_CLAUSES, Goal, all_clauses, parse_goal
 from activeintent.learners.lang.planner import generic_moves, plan
 from activeintent.learners.lang.space import Compiled
 from activeintent.protocol import sample_test_scene, stable_seed
@@ -293,6 +293,22 @@ def coverage_table(intentions: list[Intention], suites: list[str], seed: int = 0
             "suites": out, "intentions": rows}
 
 
+def explain_intention(intention, seed: int = 0) -> dict:
+    """The best goal of the language for an intention, by behaviour (bench/coverage.py), and
+    the verdict: expressible when its plan satisfies the intention on ≥ EXPRESSIBLE of the scenes."""
+    c = coverage(intention, seed=seed, start_keys=start_space_keys())
+    ok = c.success >= EXPRESSIBLE
+    verdict = "expressible" if ok else f"not expressible (best: {c.sentence!r}, {c.success:.2f})"
+    rows = [{"score": c.success, "key": c.goal, "bits": c.bits, "sentence": c.sentence}]
+    rows += [{"score": r["selection_success"], "key": r["goal"], "bits": r["bits"],
+              "sentence": parse_goal(r["goal"]).sentence()} for r in c.runner_up]
+    return {"sentence": intention.description, "intention": intention.name, "expressible": ok,
+            "note": f"{verdict}: plan success of its best goal on {c.test_scenes} feasible test scenes "
+                    f"(threshold {EXPRESSIBLE}; runners-up: success on the {SELECTION_SCENES} selection scenes)",
+            "matches": rows, "prior_rank": c.prior_rank, "in_start_space": c.in_start_space}
+
+
+
 def start_space_keys() -> set[str]:
     from activeintent.learners.lang.learner import KEEP
     from activeintent.learners.lang.space import space_info
@@ -300,4 +316,4 @@ def start_space_keys() -> set[str]:
     return set(space_info(0, KEEP)["keys"])
 
 
-__all__ = ["EXPRESSIBLE", "Coverage", "coverage", "coverage_table", "feasible_scenes", "goal_success", "start_space_keys"]
+__all__ = ["EXPRESSIBLE", "Coverage", "coverage", "coverage_table", "explain_intention", "feasible_scenes", "goal_success", "start_space_keys"]

@@ -99,9 +99,9 @@ def register(app: typer.Typer) -> None:
 
 def _explained(text: str) -> dict:
     """By behaviour for an intention's name or path.py:NAME, by words for a sentence."""
+    from activeintent.bench.coverage import explain_intention
     from activeintent.intentions.registry import IntentionError
     from activeintent.learners.lang.explain import explain as explain_sentence
-    from activeintent.learners.lang.explain import explain_intention
     from activeintent.suites import HELDOUT_SUITES, resolve, suite_of
 
     name = text.strip()

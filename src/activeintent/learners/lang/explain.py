@@ -16,9 +16,7 @@ import re
 from collections import Counter
 from functools import lru_cache
 
-from activeintent.learners.lang.expr import NODES, QUANTS, Goal, all_clauses, parse_goal
-
-SELECTION = 30  # bench.coverage.SELECTION_SCENES (not imported here: the lookup stays light)
+from activeintent.learners.lang.expr import NODES, QUANTS, Goal, all_clauses
 
 MIN_SCORE = 0.45
 STOP = {"the", "a", "an", "is", "are", "be", "should", "to", "of", "on", "in", "and", "it", "its", "their",
@@ -95,23 +93,6 @@ def explain(sentence: str, n: int = 5) -> dict:
             "note": ("goals whose sentences share the request's words (a lookup by words, not a test: "
                      "give an intention name or path.py:NAME to measure whether a goal does what it asks)"
                      if ok else "no goal's sentence shares the request's words; the closest ones are listed")}
-
-
-def explain_intention(intention, seed: int = 0) -> dict:
-    """The best goal of the language for an intention, by behaviour (bench/coverage.py), and
-    the verdict: expressible when its plan satisfies the intention on ≥ EXPRESSIBLE of the scenes."""
-    from activeintent.bench.coverage import EXPRESSIBLE, coverage, start_space_keys
-
-    c = coverage(intention, seed=seed, start_keys=start_space_keys())
-    ok = c.success >= EXPRESSIBLE
-    verdict = "expressible" if ok else f"not expressible (best: {c.sentence!r}, {c.success:.2f})"
-    rows = [{"score": c.success, "key": c.goal, "bits": c.bits, "sentence": c.sentence}]
-    rows += [{"score": r["selection_success"], "key": r["goal"], "bits": r["bits"],
-              "sentence": parse_goal(r["goal"]).sentence()} for r in c.runner_up]
-    return {"sentence": intention.description, "intention": intention.name, "expressible": ok,
-            "note": f"{verdict}: plan success of its best goal on {c.test_scenes} feasible test scenes "
-                    f"(threshold {EXPRESSIBLE}; runners-up: success on the {SELECTION} selection scenes)",
-            "matches": rows, "prior_rank": c.prior_rank, "in_start_space": c.in_start_space}
 
 
 def language_summary(examples: int = 12) -> dict:
