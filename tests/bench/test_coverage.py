@@ -5,9 +5,6 @@ rows stay hidden before a freeze."""
 
 from __future__ import annotations
 
-import itertools
-import math
-
 import numpy as np
 import pytest
 from typer.testing import CliRunner
@@ -15,7 +12,7 @@ from typer.testing import CliRunner
 from activeintent.bench import coverage as cov
 from activeintent.intentions.base import Intention
 from activeintent.learners.bayes.facts import facts
-from activeintent.learners.lang.expr import MAX_CLAUSES, parse_goal
+from activeintent.learners.lang.expr import parse_goal
 from activeintent.learners.lang.hypotheses import GoalIntention
 from activeintent.world import PutAt, WorldState, apply_skill
 from activeintent.world.scene import sample_scene
@@ -81,14 +78,11 @@ def test_an_intention_outside_the_language_is_not_expressible():
     assert not said["expressible"] and said["note"].startswith("not expressible (best: ")
 
 
-def test_the_prior_rank_counts_the_goals_with_fewer_bits():
-    rng = np.random.default_rng(3)
-    singles = np.round(rng.uniform(5, 12, 40), 1)
-    base = math.log2(MAX_CLAUSES) + 1
-    goals = [base + b for b in singles for _ in (0, 1)]  # with and without "stays"
-    goals += [base + a + b - 1 for a, b in itertools.combinations(singles, 2) for _ in (0, 1)]
-    for bits in (base + 5.5, base + 9.0, base + 14.3, base + 20.0):
-        assert cov._rank(bits, singles) == 1 + sum(g < bits - 1e-9 for g in goals)
+def test_the_prior_rank_counts_the_distinct_goals_with_fewer_bits():
+    distinct = [8.0, 9.5, 9.5, 11.0, 12.25]
+    assert [cov.prior_rank(b, distinct) for b in (7.0, 8.0, 9.5, 10.0, 13.0)] == [1, 1, 2, 4, 6]
+    info = cov.start_space_info()
+    assert info["distinct_bits"] == sorted(info["distinct_bits"]) and len(info["distinct_bits"]) == info["distinct"]
 
 
 def test_feasible_scenes_are_seeded_and_feasible():

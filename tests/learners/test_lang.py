@@ -42,12 +42,37 @@ def test_language_size_and_bits():
     assert len(CLAUSES) > 10_000
     bits = [c.bits for c in CLAUSES]
     assert min(bits) > 0
-    # the prior is a uniform choice at each node: description lengths follow the node counts
+    # the prior is a uniform choice at each node of the grammar: description lengths follow the node counts
     every_block_in_own_bowl = Each("every", "all", "", "in-bowl", "same")
     n_sel, n_rel = len(NODES["selector"]), len(NODES["relation"])
-    assert every_block_in_own_bowl.bits == pytest.approx(1 + np.log2(6) + np.log2(n_sel) + np.log2(n_rel) + np.log2(3))
+    n_in_bowl = len(NODES["relation"]["in-bowl"].params)
+    assert every_block_in_own_bowl.bits == pytest.approx(1 + np.log2(3) + np.log2(n_sel) + np.log2(n_rel) + np.log2(n_in_bowl))
+    counted = Each("exactly-1", "all", "", "in-bowl", "same")
+    assert counted.bits - every_block_in_own_bowl.bits == pytest.approx(2)  # exactly | at least, then 1 | 2
+    one = Goal((every_block_in_own_bowl,))
+    assert one.bits == pytest.approx(2 + every_block_in_own_bowl.bits)  # 1 clause: 1 bit, stays: 1 bit
     for c in CLAUSES[::97]:
         assert parse_goal(Goal((c,), True).key) == Goal((c,), True)
+
+
+def test_the_prior_of_each_clause_sums_to_one_over_the_language():
+    """Σ_c 2^-bits(c) = 1: a grammar whose every choice is a proper distribution (no mass lost)."""
+    total = sum(2.0 ** -c.bits for c in CLAUSES)
+    assert total == pytest.approx(1.0, abs=1e-9)
+
+
+def test_a_second_clause_about_the_same_or_the_other_blocks_costs_log2_3_for_its_blocks():
+    warm_left = parse_goal("every class:warm region:left half")
+    cool_right = parse_goal("every class:cool region:right half")
+    red_right = parse_goal("every colour:red region:right half")
+    pair = parse_goal("every class:warm region:left half & every class:cool region:right half")
+    other = parse_goal("every class:warm region:left half & every colour:red region:right half")
+    c1, c2 = warm_left.clauses[0], cool_right.clauses[0]
+    # two orders, each: the first clause in full, the second with its blocks by reference
+    once = c1.bits + c2.bits - c2.selector_bits + np.log2(3)
+    twice = c2.bits + c1.bits - c1.selector_bits + np.log2(3)
+    assert pair.bits == pytest.approx(2 + 1 - np.log2(2.0 ** -once + 2.0 ** -twice))
+    assert other.bits - pair.bits > red_right.clauses[0].selector_bits - 1.0  # named anew costs its selector
 
 
 def test_planner_satisfies_every_goal_it_claims_feasible():

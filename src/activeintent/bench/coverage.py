@@ -31,7 +31,6 @@ whether z* is in it, its description length L(z*) and its prior rank.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -39,7 +38,7 @@ import numpy as np
 
 from activeintent.intentions.base import Intention
 from activeintent.learners.bayes.facts import facts
-from activeintent.learners.lang.expr import MAX_CLAUSES, Goal, all_clauses, parse_goal
+from activeintent.learners.lang.expr import Goal, all_clauses, parse_goal
 from activeintent.learners.lang.planner import generic_moves, plan
 from activeintent.learners.lang.space import Compiled
 from activeintent.protocol import sample_test_scene, stable_seed
@@ -72,7 +71,7 @@ class Coverage:
     goal: str  # key of z*
     sentence: str
     bits: float
-    prior_rank: int  # 1 + goals of the search space with fewer bits
+    prior_rank: int  # 1 + distinct goals of the enumerated language with fewer bits
     in_start_space: bool
     selection_success: float
     success: float  # on the test scenes: the oracle
@@ -213,21 +212,15 @@ class Search:
         return out
 
 
-def _rank(bits: float, single_bits: np.ndarray) -> int:
-    """1 + the number of one- and two-clause goals (with and without "stays") with fewer bits."""
-    base = math.log2(MAX_CLAUSES) + 1
-    singles = int((base + single_bits < bits - 1e-9).sum()) * 2
-    s = np.sort(single_bits)
-    # pairs {a, b}, a ≠ b: bits = base + a + b − 1
-    limit = bits - base + 1 - 1e-9
-    below = np.searchsorted(s, limit - s, side="left")  # partners with a + b < limit
-    ordered = int(below.sum() - (2 * s < limit).sum())  # without a == b
-    return 1 + singles + ordered  # unordered pairs × 2 stays variants = ordered pairs
+def prior_rank(bits: float, distinct_bits) -> int:
+    """1 + the number of the language's enumerated, behaviourally distinct goals (one and two
+    clauses, with and without "stays"; the list the learner's space is cut from) with fewer bits."""
+    return 1 + int(np.searchsorted(np.asarray(distinct_bits), bits - 1e-6, side="left"))
 
 
 def coverage(intention: Intention, seed: int = 0, scenes: int = SELECTION_SCENES, test_scenes: int = TEST_SCENES,
              top: int = TOP, rounds: int = ROUNDS, start_keys: set[str] | None = None,
-             progress: Callable[[str], None] | None = None) -> Coverage:
+             distinct_bits=None, progress: Callable[[str], None] | None = None) -> Coverage:
     """The best goal of the language for ``intention`` and its plan success (the oracle)."""
     rng = np.random.default_rng(stable_seed("coverage-bank", seed, intention.name))
     chosen = feasible_scenes(intention, scenes, seed, "selection")
@@ -253,10 +246,11 @@ def coverage(intention: Intention, seed: int = 0, scenes: int = SELECTION_SCENES
     z = goals[order[0]]
     held = feasible_scenes(intention, test_scenes, seed, "test")
     success, _ = goal_success(z, held, intention)
-    single_bits = np.array([c.bits for c in clauses])
+    if distinct_bits is None:
+        distinct_bits = start_space_info()["distinct_bits"]
     return Coverage(
         intention=intention.name, description=intention.description, goal=z.key, sentence=z.sentence(),
-        bits=round(z.bits, 2), prior_rank=_rank(z.bits, single_bits),
+        bits=round(z.bits, 2), prior_rank=prior_rank(z.bits, distinct_bits),
         in_start_space=bool(start_keys is not None and z.key in start_keys),
         selection_success=round(tried[z.key], 3), success=round(success, 3), test_scenes=len(held),
         planned_goals=len(tried),
@@ -309,11 +303,15 @@ def explain_intention(intention, seed: int = 0) -> dict:
 
 
 
-def start_space_keys() -> set[str]:
+def start_space_info() -> dict:
     from activeintent.learners.lang.learner import KEEP
     from activeintent.learners.lang.space import space_info
 
-    return set(space_info(0, KEEP)["keys"])
+    return space_info(0, KEEP)
+
+
+def start_space_keys() -> set[str]:
+    return set(start_space_info()["keys"])
 
 
 __all__ = ["EXPRESSIBLE", "Coverage", "coverage", "coverage_table", "explain_intention", "feasible_scenes", "goal_success", "start_space_keys"]

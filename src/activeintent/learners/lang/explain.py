@@ -116,6 +116,6 @@ def language_summary(examples: int = 12) -> dict:
                     f"the learner starts from the {KEEP} shortest distinct goals; after each answer "
                     "neighbours of its likely goals (and with --llm a model's goals) join the belief"],
         "nodes": kinds,
-        "counts": {k: v for k, v in info.items() if k != "keys"} | {"kept": len(info["keys"])},
+        "counts": {k: v for k, v in info.items() if k not in ("keys", "distinct_bits")} | {"kept": len(info["keys"])},
         "examples": [{"key": g.key, "bits": round(g.bits, 2), "sentence": g.sentence()} for g in goals[::step]],
     }

@@ -29,7 +29,7 @@ import functools
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from itertools import combinations
+from itertools import combinations, permutations
 
 import numpy as np
 
@@ -69,9 +69,13 @@ class Node:
     key: str = ""
     params: tuple[str, ...] = ("",)
 
-    def bits(self) -> float:
+    def bits(self, p: str | None = None) -> float:
         """log2 of the choices below the kind: which type of node, then which parameter."""
-        return math.log2(len(NODES[self.kind])) + math.log2(len(self.params))
+        return math.log2(len(NODES[self.kind])) + self.param_bits(p)
+
+    def param_bits(self, p: str | None) -> float:
+        """Bits of parameter ``p``: a uniform choice unless the node's parameters are a grammar."""
+        return math.log2(len(self.params))
 
 
 class Selector(Node):
@@ -195,19 +199,56 @@ class BowlMatch(Selector):
         return (own_bowl(block) in bowls) == (p == "yes")
 
 
+class AllBut(Selector):
+    """Every block except the one(s) of one colour ("all the blocks but the green one")."""
+
+    key = "all-but"
+    params = COLOR_NAMES
+
+    def noun(self, p):
+        return f"block other than the {p} one"
+
+    def pick(self, block, bowls, p):
+        return color_of(block) != p
+
+
+def _class(block_or_bowl: str) -> str:
+    return "warm" if color_of(block_or_bowl) in WARM_COLORS else "cool"
+
+
+def _kin(a: str, b: str, p: str) -> bool:
+    """Does object ``b`` stand in colour relation ``p`` to block ``a``: same / other colour,
+    same-class / other-class (warm vs cool), or of class warm / cool."""
+    if p == "any":
+        return True
+    if p == "same":
+        return color_of(a) == color_of(b)
+    if p == "other":
+        return color_of(a) != color_of(b)
+    if p == "same-class":
+        return _class(a) == _class(b)
+    if p == "other-class":
+        return _class(a) != _class(b)
+    return _class(b) == p  # "warm" | "cool"
+
+
+KIN_WORDS = {"any": "", "same": "of its own colour", "other": "of another colour",
+             "same-class": "of its own colour class (warm / cool)", "other-class": "of the other colour class (warm / cool)",
+             "warm": "of a warm colour", "cool": "of a cool colour"}
+
+
 # ---- relations ---------------------------------------------------------------------------
 
 
 class InBowl(Relation):
     key = "in-bowl"
-    params = ("any", "same", "other")
+    params = ("any", "same", "other", "same-class", "other-class", "warm", "cool")
 
     def phrase(self, p):
-        return {"any": "in a bowl", "same": "in the bowl of its own colour",
-                "other": "in a bowl of another colour"}[p]
+        return {"any": "in a bowl", "same": "in the bowl of its own colour"}.get(p, f"in a bowl {KIN_WORDS[p]}")
 
     def _fits(self, b, w, p):
-        return p == "any" or (color_of(w) == color_of(b)) == (p == "same")
+        return _kin(b, w, p)
 
     def ok(self, f, b, p):
         w = f.bowl_of[b]
@@ -239,20 +280,21 @@ class InNamedBowl(Relation):
 
 class OnBlock(Relation):
     key = "on-block"
-    params = ("any",)
+    params = ("any", "same-class", "other-class", "warm", "cool")
 
     def phrase(self, p):
-        return "on top of another block"
+        return "on top of another block" + (f" {KIN_WORDS[p]}" if p != "any" else "")
 
     def ok(self, f, b, p):
-        return f.below[b] is not None
+        under = f.below[b]
+        return under is not None and _kin(b, under, p)
 
     def possible(self, b, objects, p):
-        return sum(kind_of(o) == "block" for o in objects) >= 2
+        return any(kind_of(o) == "block" and o != b and _kin(b, o, p) for o in objects)
 
     def targets(self, state, b, p):
         f = facts(state)
-        return [PutOn(block=b, target=o) for o in state.blocks if o != b and f.clear(o)]
+        return [PutOn(block=b, target=o) for o in state.blocks if o != b and f.clear(o) and _kin(b, o, p)]
 
 
 class OnNamedBlock(Relation):
@@ -285,29 +327,49 @@ class OnTable(Relation):
         return free_points(state, _near_first(state, b, GRID), b, 8)
 
 
+NEAR_ANY = ("a-bowl", "a-block", "block-same-class", "block-other-class")
+
+
 class NextTo(Relation):
+    """Next to a named object, to the bowl of its own colour, or to any bowl / block (of a kin)."""
+
     key = "next-to"
-    params = ALL_OBJECTS + ("own-bowl",)
+    params = ALL_OBJECTS + ("own-bowl",) + NEAR_ANY
 
     def phrase(self, p):
-        return "next to the bowl of its own colour" if p == "own-bowl" else f"next to the {p}"
+        if p == "own-bowl":
+            return "next to the bowl of its own colour"
+        if p in NEAR_ANY:
+            kind, _, kin = p.partition("-")
+            return f"next to {'a bowl' if kind == 'a' and kin == 'bowl' else 'another block'}" + (
+                f" {KIN_WORDS[kin]}" if kind == "block" else "")
+        return f"next to the {p}"
 
     def refers(self, p):
-        return None if p == "own-bowl" else p
+        return None if p == "own-bowl" or p in NEAR_ANY else p
 
-    def _target(self, b, p):
-        return own_bowl(b) if p == "own-bowl" else p
+    def _targets(self, b, objects, p) -> list[str]:
+        if p == "own-bowl":
+            return [own_bowl(b)] if own_bowl(b) in objects else []
+        if p == "a-bowl":
+            return [o for o in objects if kind_of(o) == "bowl"]
+        if p in NEAR_ANY:
+            kin = "any" if p == "a-block" else p.partition("-")[2]
+            return [o for o in objects if kind_of(o) == "block" and o != b and _kin(b, o, kin)]
+        return [p] if p in objects and p != b else []
 
     def ok(self, f, b, p):
-        return f.next_to(b, self._target(b, p))
+        if p not in NEAR_ANY:
+            t = own_bowl(b) if p == "own-bowl" else p
+            return f.next_to(b, t)
+        return any(f.next_to(b, t) for t in self._targets(b, tuple(f.blocks) + tuple(f.bowls), p))
 
     def possible(self, b, objects, p):
-        t = self._target(b, p)
-        return t in objects and t != b
+        return bool(self._targets(b, tuple(objects), p))
 
     def targets(self, state, b, p):
-        t = self._target(b, p)
-        return [PutNextTo(block=b, target=t, side=s) for s in ("nearest", "left", "right", "front", "behind")]
+        return [PutNextTo(block=b, target=t, side=s) for t in self._targets(b, tuple(state.names), p)
+                for s in ("nearest", "left", "right", "front", "behind")]
 
 
 SIDES = ("left", "right", "front", "behind")
@@ -318,14 +380,20 @@ class Beside(Relation):
     """Entirely on one side of an object (left/right along x, front/behind along y), not in a bowl."""
 
     key = "side"
-    params = tuple(f"{s}/{o}" for s in SIDES for o in ALL_OBJECTS)
+    params = tuple(f"{s}/{o}" for s in SIDES for o in ALL_OBJECTS + ("own-bowl",))
 
     def phrase(self, p):
         s, o = p.split("/")
-        return f"{SIDE_WORDS[s]} the {o}"
+        return f"{SIDE_WORDS[s]} the bowl of its own colour" if o == "own-bowl" else f"{SIDE_WORDS[s]} the {o}"
 
     def refers(self, p):
-        return p.split("/")[1]
+        o = p.split("/")[1]
+        return None if o == "own-bowl" else o
+
+    def possible(self, b, objects, p):
+        o = p.split("/")[1]
+        o = own_bowl(b) if o == "own-bowl" else o
+        return o in objects and o != b
 
     @staticmethod
     def beyond(xy_b, xy_o, o: str, s: str) -> bool:
@@ -335,10 +403,14 @@ class Beside(Relation):
 
     def ok(self, f, b, p):
         s, o = p.split("/")
-        return f.bowl_of[b] is None and self.beyond(f.xy[b], f.xy[o], o, s)
+        o = own_bowl(b) if o == "own-bowl" else o
+        return o in f.xy and f.bowl_of[b] is None and self.beyond(f.xy[b], f.xy[o], o, s)
 
     def targets(self, state, b, p):
         s, o = p.split("/")
+        o = own_bowl(b) if o == "own-bowl" else o
+        if o not in state.positions:
+            return []
         xy_o = state.pos(o)[:2]
         pts = [q for q in GRID if self.beyond(q, xy_o, o, s)]
         return [PutNextTo(block=b, target=o, side=s)] + free_points(state, _near_first(state, o, pts), b, 5)
@@ -401,18 +473,43 @@ def _flat(f: Facts, b: str) -> bool:
     return b in f.on_table and f.below[b] is None and f.above[b] is None
 
 
+ORDERS = ("any", "rainbow", "warm-first", "cool-first")
+ORDER_WORDS = {"rainbow": "in rainbow order", "warm-first": "the warm-coloured ones first",
+               "cool-first": "the cool-coloured ones first"}
+
+
+def _order_key(order: str):
+    """Sort key of an order: the rainbow rank, or the colour class (then the rainbow rank, so
+    that a plan has one target; any arrangement with the classes in order satisfies it)."""
+    if order == "rainbow":
+        return _rank
+    first = "warm" if order == "warm-first" else "cool"
+    return lambda b: (_class(b) != first, _rank(b))
+
+
+def in_order(seq, order: str) -> bool:
+    """Is ``seq`` (left→right, front→back or bottom→top) in ``order``?"""
+    if order == "any":
+        return True
+    if order == "rainbow":
+        return list(seq) == sorted(seq, key=_rank)
+    first = "warm" if order == "warm-first" else "cool"
+    ks = [_class(b) != first for b in seq]
+    return ks == sorted(ks)
+
+
 class Line(Structure):
     """A straight row (axis 1: same y, along x) or column (axis 0: same x, along y) of flat
-    blocks, neighbours next to each other; ``rainbow``: in rainbow order left→right / front→back."""
+    blocks, neighbours next to each other; in an order left→right / front→back (ORDERS)."""
 
-    params = ("any", "rainbow")
+    params = ORDERS
     axis = 1
     sides = ("right", "left")
     words = ("one left-to-right row", "left to right")
 
     def sentence(self, subject, p):
         text = f"{subject} form {self.words[0]} on the table, each next to its neighbour"
-        return text + (f", in rainbow order {self.words[1]}" if p == "rainbow" else "")
+        return text + (f", {ORDER_WORDS[p]} {self.words[1]}" if p != "any" else "")
 
     def line(self, f: Facts, blocks, p: str) -> bool:
         if len(blocks) < 1 or not all(_flat(f, b) for b in blocks):
@@ -421,7 +518,7 @@ class Line(Structure):
         if max(across) - min(across) > ALIGN_TOL:
             return False
         along = sorted(blocks, key=lambda b: f.xy[b][1 - self.axis])
-        if p == "rainbow" and along != sorted(blocks, key=_rank):
+        if not in_order(along, p):
             return False
         return all(f.xy[b][1 - self.axis] - f.xy[a][1 - self.axis] >= MIN_SPACING and f.next_to(a, b)
                    for a, b in zip(along, along[1:], strict=False))
@@ -455,7 +552,14 @@ class Line(Structure):
             return []
         lo, hi = chain[0], chain[-1]
         out: list[Skill] = []
-        for b in sorted(rest, key=_rank) if p == "rainbow" else rest:
+        if p != "any":  # build the order from its first block on: the prefix in line, then the next
+            want = sorted(g, key=_order_key(p))
+            k = max((n for n in range(1, len(want) + 1) if self.line(f, tuple(want[:n]), p)), default=0)
+            if k == 0:
+                out += free_points(state, _near_first(state, want[0], GRID), want[0], 4)
+            elif k < len(want):
+                out.append(PutNextTo(block=want[k], target=want[k - 1], side=self.sides[0]))
+        for b in sorted(rest, key=_order_key(p)) if p != "any" else rest:
             out += [PutNextTo(block=b, target=hi, side=self.sides[0]), PutNextTo(block=b, target=lo, side=self.sides[1])]
         return out
 
@@ -484,9 +588,9 @@ def _towers(f: Facts, g: Group) -> list[list[str]]:
     return sorted(out, key=len, reverse=True)
 
 
-def _ordered_height(f: Facts, g: Group) -> int:
-    """How many blocks of the rainbow-ordered group already stand in order from the bottom."""
-    want = sorted(g, key=_rank)
+def _ordered_height(f: Facts, g: Group, order: str = "rainbow") -> int:
+    """How many blocks of the ordered group already stand in order from the bottom."""
+    want = sorted(g, key=_order_key(order))
     if f.below[want[0]] is not None:
         return 0
     chain = f.tower(want[0])
@@ -498,32 +602,31 @@ def _ordered_height(f: Facts, g: Group) -> int:
 
 class Tower(Structure):
     key = "tower"
-    params = ("any", "rainbow")
+    params = ORDERS
 
     def sentence(self, subject, p):
-        return f"{subject} are stacked into one tower" + (
-            " in rainbow order from the bottom up" if p == "rainbow" else "")
+        return f"{subject} are stacked into one tower" + (f", {ORDER_WORDS[p]} from the bottom up" if p != "any" else "")
 
     def holds(self, f, g, p):
         if p == "rainbow":
             return _ordered_height(f, g) == len(g) and f.above[sorted(g, key=_rank)[-1]] is None
         t = _towers(f, g)
-        return bool(t) and len(t[0]) == len(g)
+        return bool(t) and len(t[0]) == len(g) and in_order(t[0], p)
 
     def score(self, f, g, p):
-        if p == "rainbow":
-            return _ordered_height(f, g) / len(g)
-        t = _towers(f, g)
-        return len(t[0]) / len(g) if t else 0.0
+        if p == "any":
+            t = _towers(f, g)
+            return len(t[0]) / len(g) if t else 0.0
+        return 1.0 if self.holds(f, g, p) else _ordered_height(f, g, p) / len(g)
 
     def moved_ok(self, fb, fa, g, b, p):
         return fa.below[b] is not None or len(g) == 1
 
     def suggest(self, state, g, p):
         f = facts(state)
-        if p == "rainbow":
-            want = sorted(g, key=_rank)
-            n = _ordered_height(f, g)
+        if p != "any":
+            want = sorted(g, key=_order_key(p))
+            n = _ordered_height(f, g, p)
             if n == 0:
                 return free_points(state, _near_first(state, want[0], GRID), want[0], 6)
             return [PutOn(block=want[n], target=want[n - 1])] if n < len(want) else []
@@ -728,10 +831,214 @@ class Corners(Structure):
         return out
 
 
-for _node in (AllBlocks(), ColourBlock(), ColourClass(), BowlMatch(),
+class EachBowl(Structure):
+    """Every bowl of the scene holds exactly ``n`` blocks of the group (the rest stay out)."""
+
+    key = "each-bowl"
+    params = ("1", "2")
+    min_size = 1
+
+    def sentence(self, subject, p):
+        return f"every bowl holds exactly {NUMBER[p]} of {subject}"
+
+    def _counts(self, f, g):
+        c = dict.fromkeys(f.bowls, 0)
+        for b in g:
+            if (w := f.bowl_of[b]) is not None:
+                c[w] += 1
+        return c
+
+    def holds(self, f, g, p):
+        return bool(f.bowls) and all(n == int(p) for n in self._counts(f, g).values())
+
+    def score(self, f, g, p):
+        c = self._counts(f, g)
+        return sum(min(n, int(p)) - max(n - int(p), 0) for n in c.values()) / max(len(c) * int(p), 1)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        w = fa.bowl_of[b]
+        return w is None or self._counts(fa, g)[w] <= int(p)
+
+    def possible(self, g, objects, p):
+        bowls = sum(kind_of(o) == "bowl" for o in objects)
+        return bowls >= 1 and len(g) >= bowls * int(p)
+
+    def suggest(self, state, g, p):
+        f = facts(state)
+        c = self._counts(f, g)
+        out: list[Skill] = []
+        for w, n in c.items():
+            if n > int(p):
+                out += [s for b in g if f.bowl_of[b] == w and f.clear(b) for s in OnTable().targets(state, b, "")[:4]]
+        short = [w for w, n in c.items() if n < int(p)]
+        return out + [PutIn(block=b, bowl=w) for w in short for b in g if f.bowl_of[b] is None]
+
+
+class AroundBowl(Structure):
+    """Every block of the group on the table right next to one and the same bowl."""
+
+    key = "around-bowl"
+    min_size = 1
+
+    def sentence(self, subject, p):
+        return f"{subject} stand on the table around one bowl, each right next to it"
+
+    def _best(self, f, g):
+        return max(((sum(f.flat(b) and f.next_to(b, w) for b in g), w) for w in f.bowls), default=(0, None))
+
+    def holds(self, f, g, p):
+        return self._best(f, g)[0] == len(g)
+
+    def score(self, f, g, p):
+        return self._best(f, g)[0] / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        return fa.flat(b) and any(fa.next_to(b, w) for w in fa.bowls)
+
+    def possible(self, g, objects, p):
+        return any(kind_of(o) == "bowl" for o in objects) and len(g) <= 4
+
+    def suggest(self, state, g, p):
+        f = facts(state)
+        n, best = self._best(f, g)
+        bowls = [best] + [w for w in state.bowls if w != best] if best else list(state.bowls)
+        return [PutNextTo(block=b, target=w, side=s) for w in bowls[:2] for b in g
+                if not (f.flat(b) and f.next_to(b, w)) for s in ("nearest", "left", "right", "front", "behind")]
+
+
+class GroupsByClass(Structure):
+    """Two groups on the table: the warm-coloured blocks together, the cool-coloured ones
+    together, and no warm block touching a cool one."""
+
+    key = "groups-by-class"
+    min_size = 3
+
+    def sentence(self, subject, p):
+        return f"{subject} form two separate groups on the table, the warm-coloured ones together and the cool-coloured ones together"
+
+    def holds(self, f, g, p):
+        parts = TowersByClass.parts(g)
+        return (len(parts) == 2 and all(Cluster().holds(f, part, "") for part in parts)
+                and not any(f.next_to(a, b) for a in parts[0] for b in parts[1]))
+
+    def score(self, f, g, p):
+        parts = TowersByClass.parts(g)
+        touching = sum(f.next_to(a, b) for a in parts[0] for b in parts[-1]) if len(parts) == 2 else 0
+        s = sum(Cluster().score(f, part, "") * len(part) for part in parts) / len(g)
+        return max(s - touching / len(g), 0.0)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        parts = TowersByClass.parts(g)
+        other = next((x for x in parts if b not in x), ())
+        return fa.flat(b) and not any(fa.next_to(b, o) for o in other)
+
+    def possible(self, g, objects, p):
+        return len(TowersByClass.parts(g)) == 2 and len(g) >= 3
+
+    def suggest(self, state, g, p):
+        return [s for part in TowersByClass.parts(g) for s in Cluster().suggest(state, part, "")]
+
+
+PLACES = ("back-edge", "front-edge", "left-edge", "right-edge", "middle", "a-corner", "by-a-bowl")
+PLACE_WORDS = {"back-edge": "along the back edge of the table", "front-edge": "along the front edge of the table",
+               "left-edge": "along the left edge of the table", "right-edge": "along the right edge of the table",
+               "middle": "in the middle of the table", "a-corner": "in one corner of the table",
+               "by-a-bowl": "right next to one bowl"}
+EDGE = 0.1  # "along an edge": centres within 10 cm of it (the workspace is 60 × 60 cm)
+PLACE_AREA = {"back-edge": lambda xy: xy[1] > -0.2 - EDGE, "front-edge": lambda xy: xy[1] < -0.8 + EDGE,
+              "left-edge": lambda xy: xy[0] < -0.3 + EDGE, "right-edge": lambda xy: xy[0] > 0.3 - EDGE,
+              "middle": lambda xy: abs(xy[0]) < 0.15 and abs(xy[1] + 0.5) < 0.1}
+
+
+@functools.cache
+def place_points(place: str) -> tuple[tuple[float, float], ...]:
+    """Grid points of an area, nearest its centre first."""
+    inside = PLACE_AREA[place]
+    pts = [q for q in GRID if inside(q)]
+    cx, cy = float(np.mean([q[0] for q in pts])), float(np.mean([q[1] for q in pts]))
+    return tuple(sorted(pts, key=lambda q: (q[0] - cx) ** 2 + (q[1] - cy) ** 2))
+
+
+class Placed(Structure):
+    """A structure at a place: "a row along the back edge", "a tower next to a bowl", "grouped in
+    one corner". Parameters ``order`` or ``order@place``; their bits are a small grammar: one bit
+    for "in an order", then which order (uniform); one bit for "at a place", then which place."""
+
+    def __init__(self, inner: Structure, orders: tuple[str, ...]):
+        self.inner = inner
+        self.key = inner.key
+        self.min_size = inner.min_size
+        self.orders = orders
+        self.params = orders + tuple(f"{o}@{pl}" for o in orders for pl in PLACES)
+
+    def param_bits(self, p):
+        if p is None:
+            return math.log2(len(self.params))
+        order, _, place = p.partition("@")
+        ordered = 0.0 if len(self.orders) == 1 else 1 + (math.log2(len(self.orders) - 1) if order != "any" else 0)
+        return ordered + 1 + (math.log2(len(PLACES)) if place else 0)
+
+    def sentence(self, subject, p):
+        order, _, place = p.partition("@")
+        return self.inner.sentence(subject, order) + (f", {PLACE_WORDS[place]}" if place else "")
+
+    @staticmethod
+    def _share(f: Facts, g: Group, place: str) -> float:
+        """Share of the group standing (itself or its tower's base) on the table at the place;
+        for a corner or a bowl: the same corner / bowl for all."""
+        bases = [f.base(b) for b in g]
+        down = [b for b in bases if b in f.on_table and f.bowl_of[b] is None]
+        if place in PLACE_AREA:
+            return sum(PLACE_AREA[place](f.xy[b]) for b in down) / len(g)
+        if place == "a-corner":
+            return max((sum(REGIONS[c](f.xy[b]) for b in down) for c in CORNERS), default=0) / len(g)
+        return max((sum(f.next_to(b, w) for b in down) for w in f.bowls), default=0) / len(g)
+
+    def holds(self, f, g, p):
+        order, _, place = p.partition("@")
+        return self.inner.holds(f, g, order) and (not place or self._share(f, g, place) == 1.0)
+
+    def score(self, f, g, p):
+        order, _, place = p.partition("@")
+        s = float(self.inner.score(f, g, order))
+        return s if not place else (s + self._share(f, g, place)) / 2
+
+    def moved_ok(self, fb, fa, g, b, p):
+        order, _, place = p.partition("@")
+        if not self.inner.moved_ok(fb, fa, g, b, order):
+            return False
+        return not place or self._share(fa, (b,), place) == 1.0 or self._share(fa, g, place) >= self._share(fb, g, place)
+
+    def possible(self, g, objects, p):
+        order, _, place = p.partition("@")
+        return self.inner.possible(g, objects, order) and (place != "by-a-bowl" or any(
+            kind_of(o) == "bowl" for o in objects))
+
+    def suggest(self, state, g, p):
+        order, _, place = p.partition("@")
+        inner = self.inner.suggest(state, g, order)
+        if not place:
+            return inner
+        f = facts(state)
+        here = {b for b in g if self._share(f, (f.base(b),), place) == 1.0}
+        if here:  # grow the structure from the part already in place: moves onto / next to it first
+            onto = [st for st in inner if getattr(st, "target", None) in here]
+            return onto + [st for st in inner if st not in onto]
+        first = sorted(g, key=_order_key(order)) if order not in ("any", "") else list(g)
+        movers = [b for b in first if f.clear(b)][:2]
+        if place in PLACE_AREA:
+            return [s for b in movers for s in free_points(state, place_points(place), b, 6)] + inner
+        if place == "a-corner":
+            return [s for b in movers for c in CORNERS for s in free_points(state, region_points(c), b, 2)] + inner
+        return [PutNextTo(block=b, target=w, side=sd) for b in movers for w in state.bowls
+                for sd in ("nearest", "left", "right", "front", "behind")] + inner
+
+
+for _node in (AllBlocks(), ColourBlock(), ColourClass(), BowlMatch(), AllBut(),
               InBowl(), InNamedBowl(), OnBlock(), OnNamedBlock(), OnTable(), NextTo(), Beside(), InRegion(),
-              Row(), Column(), Tower(), TowersByClass(), TwoTowers(), OneBowl(), SeparateBowls(), Cluster(),
-              Corners()):
+              Placed(Row(), ORDERS), Placed(Column(), ORDERS), Placed(Tower(), ORDERS), TowersByClass(), TwoTowers(),
+              OneBowl(), SeparateBowls(), Placed(Cluster(), ("",)), Corners(), EachBowl(), AroundBowl(),
+              GroupsByClass()):
     register(_node)
 
 
@@ -739,6 +1046,10 @@ for _node in (AllBlocks(), ColourBlock(), ColourClass(), BowlMatch(),
 
 MAX_CLAUSES = 3  # a goal is a conjunction of 1–3 clauses
 QUANTS = ("every", "none", "exactly-1", "exactly-2", "at-least-1", "at-least-2")
+# The quantifier is a small grammar, uniform at each choice: every | none | a count; a count is
+# "exactly" or "at least", then the number (1 or 2).
+QUANT_BITS = {q: math.log2(3) + (0 if q in ("every", "none") else 2) for q in QUANTS}
+REUSE_BITS = math.log2(3)  # a later clause's blocks: the same as the clause before | the others | named anew
 NUMBER = {"1": "one", "2": "two"}
 
 
@@ -790,7 +1101,11 @@ class Each:
 
     @property
     def bits(self) -> float:
-        return 1 + math.log2(len(QUANTS)) + NODES["selector"][self.sel].bits() + NODES["relation"][self.rel].bits()
+        return 1 + QUANT_BITS[self.quant] + self.selector_bits + NODES["relation"][self.rel].bits()
+
+    @property
+    def selector_bits(self) -> float:
+        return NODES["selector"][self.sel].bits()
 
     @property
     def relation(self) -> Relation:
@@ -895,7 +1210,11 @@ class Form:
 
     @property
     def bits(self) -> float:
-        return 1 + NODES["structure"][self.struct].bits() + NODES["selector"][self.sel].bits()
+        return 1 + NODES["structure"][self.struct].bits(self.stp) + self.selector_bits
+
+    @property
+    def selector_bits(self) -> float:
+        return NODES["selector"][self.sel].bits()
 
     @property
     def structure(self) -> Structure:
@@ -963,10 +1282,28 @@ class Goal:
 
     @property
     def bits(self) -> float:
-        """log2(MAX_CLAUSES) for how many clauses, 1 bit for the stays flag, the clauses;
-        − log2(n!) since the clauses' order says nothing."""
+        """Description length L(z): how many clauses (geometric: n bits for n clauses), 1 bit for
+        the stays flag, then the clauses. A clause after the first names its blocks by reference
+        to the clause before — the same blocks, or the others (the complement) — for log2(3)
+        bits instead of log2(3) + its selector's bits. The clauses' order says nothing, so
+        P(z) sums over the orders in which z can be written (n! derivations)."""
+        if self._bits >= 0:
+            return self._bits
         n = len(self.clauses)
-        return math.log2(MAX_CLAUSES) + 1 + sum(c.bits for c in self.clauses) - math.log2(math.factorial(n))
+        if n == 1:
+            bits = 2 + self.clauses[0].bits
+        else:
+            total = 0.0
+            for order in permutations(self.clauses):
+                b = order[0].bits
+                for prev, c in zip(order, order[1:], strict=False):
+                    b += c.bits - c.selector_bits + REUSE_BITS
+                    if not _refers_back(prev, c):
+                        b += c.selector_bits
+                total += 2.0 ** -b
+            bits = n + 1 - math.log2(total)
+        object.__setattr__(self, "_bits", bits)
+        return bits
 
     def sentence(self) -> str:
         parts = [c.sentence() for c in self.clauses]
@@ -991,6 +1328,24 @@ class Goal:
 
     def possible(self, objects: tuple[str, ...]) -> bool:
         return all(c.possible(tuple(objects)) for c in self.clauses)
+
+
+def complement(sel: str, sp: str) -> tuple[str, str] | None:
+    """The selector of the other blocks (every block has a colour, a class, a bowl or not)."""
+    if sel == "colour":
+        return "all-but", sp
+    if sel == "all-but":
+        return "colour", sp
+    if sel == "class":
+        return "class", "cool" if sp == "warm" else "warm"
+    if sel == "matching":
+        return "matching", "no" if sp == "yes" else "yes"
+    return None
+
+
+def _refers_back(prev: Clause, c: Clause) -> bool:
+    """Are ``c``'s blocks those of ``prev`` or the others?"""
+    return (c.sel, c.sp) == (prev.sel, prev.sp) or (c.sel, c.sp) == complement(prev.sel, prev.sp)
 
 
 def parse_clause(key: str) -> Clause:

@@ -320,7 +320,7 @@ def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scen
     # The space starts as the ``keep`` shortest distinct goals (most probable first under the
     # prior); longer ones join while learning (proposals.py).
     kept = [k for _, k in distinct[:keep]]
-    return {"keys": kept, "generated": generated, "clauses": n, "distinct": len(distinct),
+    return {"keys": kept, "distinct_bits": [round(b, 4) for b, _ in distinct], "generated": generated, "clauses": n, "distinct": len(distinct),
             "pair_clauses": len(idx), "probe_scenes": len(scenes), "probe_states": len(states),
             "probe_moves": len(moves), "seconds": round(time.time() - t0, 1)}
 
