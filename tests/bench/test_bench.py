@@ -152,7 +152,7 @@ def test_bench_refuses_setups_that_cannot_run(tmp_path):
 @pytest.mark.slow
 def test_killed_bench_resumes_without_duplicates(tmp_path):
     out = tmp_path / "killed"
-    cmd = [sys.executable, "-m", "activeintent.cli", "bench", "--methods", ",".join(METHODS), "--intentions",
+    cmd = [sys.executable, "-m", "activeintent.cli", "bench", "--no-oracle", "--methods", ",".join(METHODS), "--intentions",
            "stack,color-match,align", "--trials", "2", "--budget", "2", "--seed", "9", "--llm", "none",
            "--env", "symbolic", "--out", str(out)]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)

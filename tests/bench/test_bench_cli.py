@@ -12,7 +12,7 @@ from activeintent.cli import app
 
 ROOT = Path(__file__).resolve().parents[2]
 MINE = f"{ROOT}/examples/my_intention.py:RightmostBowl"
-TINY = ["--env", "symbolic", "--llm", "none", "--budget", "1", "--trials", "1", "--test-scenes", "2",
+TINY = ["--no-oracle", "--env", "symbolic", "--llm", "none", "--budget", "1", "--trials", "1", "--test-scenes", "2",
         "--test-pool", "0"]
 runner = CliRunner()
 
@@ -60,3 +60,20 @@ def test_perf_bench_prints_a_line_per_episode_on_stderr_and_keeps_stdout_json():
     assert json.loads(res.stdout)["settings"]["symbolic"]["signals"] == 1
     line = next(line for line in res.stderr.splitlines() if line.startswith("1/1 · "))
     assert line.split(" · ")[:4] == ["1/1", "bayes-stop", "symbolic", "color-match"] and "ETA" in line
+
+
+def test_the_report_carries_the_oracle_row_measured_by_coverage(tmp_path):
+    from activeintent.bench.coverage import cached_coverage
+    from activeintent.suites import resolve
+
+    out = tmp_path / "b"
+    tiny = [a for a in TINY if a != "--no-oracle"]
+    res = runner.invoke(app, ["bench", "--methods", "zero-signal", "--intentions", "stack", *tiny, "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    row = next(line for line in (out / "report.md").read_text().splitlines() if line.startswith("| *oracle*"))
+    want = cached_coverage(resolve("stack"))["success"]  # the cache the bench filled
+    assert f"| {want:.2f} |" in row and f"**{want:.2f}**" in row
+    out2 = tmp_path / "c"
+    res = runner.invoke(app, ["bench", "--methods", "zero-signal", "--intentions", "stack", *TINY, "--out", str(out2)])
+    assert "not measured" in next(line for line in (out2 / "report.md").read_text().splitlines()
+                                  if line.startswith("| *oracle*"))

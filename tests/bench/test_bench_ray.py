@@ -126,7 +126,7 @@ def test_a_killed_ray_bench_resumes_without_duplicates(tmp_path):
     plugin = tmp_path / "waits.py"
     plugin.write_text(WAITING_INTENTION.format(flag=str(flag)))
     out = tmp_path / "killed"
-    cmd = [sys.executable, "-m", "activeintent.cli", "bench", "--backend", "ray", "--jobs", "2",
+    cmd = [sys.executable, "-m", "activeintent.cli", "bench", "--no-oracle", "--backend", "ray", "--jobs", "2",
            "--methods", ",".join(METHODS), "--intentions", ",".join(INTENTIONS), "--intention-file",
            f"{plugin}:Waits", "--trials", "1", "--budget", "2", "--seed", "9", "--llm", "none",
            "--env", "symbolic", "--out", str(out)]

@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 # bayes-stop: EIG + final expected success (the near-ties that used to follow the BLAS kernel);
 # lang-preference: the goal-language space built from an empty cache, two-outcome queries.
-BENCH = ["bench", "--methods", "bayes-stop,lang-preference,zero-signal", "--intentions", "align,dev-warm-on-cool",
+BENCH = ["bench", "--no-oracle", "--methods", "bayes-stop,lang-preference,zero-signal", "--intentions", "align,dev-warm-on-cool",
          "--trials", "1", "--budget", "3", "--test-pool", "10", "--env", "symbolic", "--llm", "none"]
 
 

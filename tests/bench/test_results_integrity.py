@@ -17,7 +17,7 @@ from activeintent.cli import app
 from activeintent.results import hold_results_folder, load_results
 
 ROOT = Path(__file__).resolve().parents[2]
-TINY = ["--methods", "zero-signal", "--intentions", "color-match", "--budget", "2", "--test-scenes", "2",
+TINY = ["--no-oracle", "--methods", "zero-signal", "--intentions", "color-match", "--budget", "2", "--test-scenes", "2",
         "--test-pool", "0", "--env", "symbolic", "--llm", "none", "--seed", "3"]
 cli = CliRunner()
 

@@ -332,7 +332,7 @@ def test_bench_preset_table1_runs_the_papers_methods_beside_its_rows(tmp_path, m
     refused = runner.invoke(app, ["bench", "--preset", "table1", "--budget", "3", "--out", str(tmp_path / "x")])
     assert refused.exit_code == 2 and "K = 5" in refused.output
     with ChatServer() as server:
-        res = runner.invoke(app, ["bench", "--preset", "table1", "--trials", "1", "--test-scenes", "1", "--env", "symbolic",
+        res = runner.invoke(app, ["bench", "--no-oracle", "--preset", "table1", "--trials", "1", "--test-scenes", "1", "--env", "symbolic",
                                   "--user", "exact", "--llm", "openai:fake", "--base-url", server.base_url,
                                   "--executor", "cap", "--cache", str(tmp_path / "c.sqlite"), "--out", str(tmp_path / "b")])
     assert res.exit_code == 0, res.output

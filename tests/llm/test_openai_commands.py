@@ -38,7 +38,7 @@ def test_run_exits_3_naming_the_model_and_writes_the_summary(tmp_path, case):
 
 
 def test_bench_records_a_model_failure_as_an_error_that_retry_errors_reruns(tmp_path):
-    bench = ["bench", "--methods", "preference", "--intentions", "color-match", "--trials", "1", "--budget", "1",
+    bench = ["bench", "--no-oracle", "--methods", "preference", "--intentions", "color-match", "--trials", "1", "--budget", "1",
              "--env", "symbolic", "--test-scenes", "2", "--test-pool", "0", "--cache-mode", "off",
              "--llm", "openai:fake-model", "--out", str(tmp_path)]
     with FaultServer() as server:

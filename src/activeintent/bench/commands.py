@@ -70,6 +70,7 @@ def bench(
     backend: Annotated[str, typer.Option("--backend", help="local (process pool) | ray (one task per episode; docs/scaling.md)")] = "local",
     ray_address: Annotated[str | None, typer.Option("--ray-address", help="With --backend ray: cluster to use (e.g. auto); default $RAY_ADDRESS, else a local Ray")] = None,
     keep_episodes: Annotated[bool, typer.Option(help="Keep each episode's rounds.jsonl and summary.json")] = False,
+    oracle: Annotated[bool, typer.Option(help="Add the oracle row: coverage of each intention by the goal language (≈ 10–20 s each, cached)")] = True,
     retry_errors: Annotated[bool, typer.Option(help="Re-run episodes that ended in an error")] = False,
     out: Annotated[Path, typer.Option("--out", help="Results folder; re-running with it resumes")] = Path("runs/bench"),
 ) -> None:
@@ -130,7 +131,14 @@ def bench(
         raise typer.Exit(2) from None
     settings = {**protocol_fields(run), "trials": trials, "seed": seed, **({"preset": preset} if preset else {})}
     all_intentions = intention_list + list(intention_file or [])
-    report = write_report(records, method_list, all_intentions, out, settings, labels=labels)
+    ceiling = None
+    if oracle:
+        from activeintent.bench.coverage import oracle_of
+        from activeintent.progress_lines import print_line
+
+        ceiling = oracle_of({i: resolve(None, i) if ".py:" in i else resolve(i) for i in all_intentions},
+                            progress=lambda text: print_line(console, text))
+    report = write_report(records, method_list, all_intentions, out, settings, labels=labels, oracle=ceiling)
     plot_success_vs_signals(records, method_list, budget, out, labels=labels, settings=settings)
     console.print(report.read_text(), markup=False, soft_wrap=True)
     console.print(f"report: {out / 'report.md'}  plot: {out / 'success_vs_signals.png'}", markup=False)

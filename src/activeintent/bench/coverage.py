@@ -303,6 +303,49 @@ def explain_intention(intention, seed: int = 0) -> dict:
 
 
 
+def cached_coverage(intention: Intention, seed: int = 0) -> dict:
+    """``coverage(intention).row()``, kept on disk per language (the cache key of the learner's
+    space: the language's sources and node types), intention (its class's source) and seed."""
+    import hashlib
+    import inspect
+    import json
+    import os
+    from pathlib import Path
+
+    from activeintent.learners.lang.space import cache_path
+
+    try:
+        source = inspect.getsource(type(intention))
+    except (OSError, TypeError):
+        source = repr(type(intention))
+    tag = hashlib.sha256("\0".join([Path(__file__).read_text(), intention.name, intention.description, source,
+                                    getattr(getattr(intention, "goal", None), "key", "")]).encode()).hexdigest()[:16]
+    path = cache_path(f"coverage-{seed}-{tag}")
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        pass
+    row = coverage(intention, seed=seed, start_keys=start_space_keys()).row()
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(row))
+        os.replace(tmp, path)
+    except OSError:
+        pass
+    return row
+
+
+def oracle_of(intentions: dict[str, Intention], progress: Callable[[str], None] | None = None) -> dict[str, dict]:
+    """Coverage of every intention of a bench (the report's oracle row), cached."""
+    out = {}
+    for k, (name, it) in enumerate(intentions.items(), 1):
+        out[name] = cached_coverage(it)
+        if progress:
+            progress(f"oracle: coverage {k}/{len(intentions)}")
+    return out
+
+
 def start_space_info() -> dict:
     from activeintent.learners.lang.learner import KEEP
     from activeintent.learners.lang.space import space_info
@@ -314,4 +357,4 @@ def start_space_keys() -> set[str]:
     return set(start_space_info()["keys"])
 
 
-__all__ = ["EXPRESSIBLE", "Coverage", "coverage", "coverage_table", "explain_intention", "feasible_scenes", "goal_success", "start_space_keys"]
+__all__ = ["EXPRESSIBLE", "Coverage", "coverage", "cached_coverage", "coverage_table", "explain_intention", "oracle_of", "feasible_scenes", "goal_success", "start_space_keys"]

@@ -242,8 +242,9 @@ COLUMNS = ("Columns: **intentions** and **all**: success@K, mean over episodes [
 
 
 def write_report(records: list[dict], methods: list[str], intentions: list[str], out: Path, settings: dict,
-                 labels: dict[str, str] | None = None) -> Path:
-    """``labels``: the name of each path.py:NAME intention (the report shows names, not class names)."""
+                 labels: dict[str, str] | None = None, oracle: dict[str, dict] | None = None) -> Path:
+    """``labels``: the name of each path.py:NAME intention (the report shows names, not class names);
+    ``oracle``: coverage of each intention (bench/coverage.py), shown as the oracle row."""
     by = defaultdict(list)
     for r in records:
         by[(r["method"], r["intention"])].append(r)
@@ -292,6 +293,7 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
                 label += " [" + "/".join(sorted({str(r.get("variant") or "structured") for r in ok})) + "]"
             lines.append(f"| {label} | " + " | ".join(cells) + f" | **{rate([r['success'] for r in ok])}** | "
                          f"{signals:.1f} | {new}/{total} | {excl:.1f} | {dis} | {errors} | {len(every) - len(ok) - errors} |")
+        lines += _oracle_row(oracle, suite, names, len(names))
         lines += ["", COLUMNS, "", _scored_line(by, methods, names, labels)]
         if suite == "paper":
             cols = [i for i in names if i in PAPER_TABLE1["preference"][0]]
@@ -316,6 +318,23 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
     path = out / "report.md"
     path.write_text("\n".join(lines))
     return path
+
+
+def _oracle_row(oracle: dict[str, dict] | None, suite: str, names: list[str], width: int) -> list[str]:
+    """The ceiling of every learner of the goal language: the best goal's plan success per
+    intention (held-out suites: the mean only, their rows are read only after a freeze)."""
+    if oracle is None:
+        return ["| *oracle* (best goal of the goal language) | " + " | ".join("–" for _ in names)
+                + " | not measured (`bench --no-oracle`) | | | | | | |"]
+    from activeintent.suites import HELDOUT_SUITES
+
+    got = [oracle[i]["success"] for i in names if i in oracle]
+    n = oracle[names[0]]["test_scenes"] if names and names[0] in oracle else 0
+    cells = ["held out" if suite in HELDOUT_SUITES else (f"{oracle[i]['success']:.2f}" if i in oracle else "–")
+             for i in names]
+    mean = f"**{np.mean(got):.2f}** (mean of {len(got)}; plan success on {n} scenes each)" if got else "–"
+    return ["| *oracle* (best goal of the goal language: the ceiling of lang-* / decide-*) | " + " | ".join(cells)
+            + f" | {mean} | | | | | | |"]
 
 
 def success_at_k_table(records: list[dict], methods: list[str], budget: int) -> list[str]:
