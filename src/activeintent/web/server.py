@@ -254,7 +254,8 @@ def create_app(
     app.state.manager = manager
     app.state.limits = guard
     install_error_handlers(app)
-    app.add_middleware(BodyGuard, max_body_bytes=limits.max_body_bytes)
+    app.add_middleware(BodyGuard, max_body_bytes=limits.max_body_bytes, drain_bytes=limits.drain_bytes,
+                       drain_timeout=limits.body_timeout)
 
     def session_or_404(sid: str) -> WebSession:
         session = manager.get(sid)
