@@ -52,3 +52,30 @@ def test_a_body_over_the_limit_sent_before_reading_gets_its_413(live_server):
         assert status == 413, (framing, status, text[:200])
         assert error_code(text) == "body_too_large" and headers["connection"] == "close"
     assert srv.manager.all() == []
+
+
+# -- ambiguous framing --------------------------------------------------------------------------
+def test_a_request_with_both_content_length_and_transfer_encoding_is_refused(live_server):
+    srv = live_server("bayes-stop", rounds=1)
+    host, port = host_port(srv.url)
+    body = b'{"participant": "smuggled"}'
+    chunked = b"%x\r\n" % len(body) + body + b"\r\n0\r\n\r\n"
+    for headers in ([f"Content-Length: {len(chunked)}", "Transfer-Encoding: chunked"],
+                    ["Transfer-Encoding: chunked", f"Content-Length: {len(body)}"],
+                    ["Content-Length: 0", "Transfer-Encoding: chunked"]):
+        with socket.create_connection((host, port), timeout=30) as sock:
+            head = "\r\n".join(["POST /api/sessions HTTP/1.1", f"Host: {host}:{port}",
+                                "Content-Type: application/json", *headers]) + "\r\n\r\n"
+            sock.sendall(head.encode() + chunked)
+            status, res_headers, text = read_response(sock)
+        assert status == 400, (headers, status, text[:200])
+        assert error_code(text) == "ambiguous_framing" and res_headers["connection"] == "close"
+    assert srv.manager.all() == [], "a request with ambiguous framing started a session"
+    # one framing header alone is fine: the body reaches the app (here: an unknown session)
+    events = b'{"events": [{"type": "x", "client_ts": 1}]}'
+    with socket.create_connection((host, port), timeout=30) as sock:
+        sock.sendall(f"POST /api/sessions/{'0' * 16}/events HTTP/1.1\r\nHost: {host}:{port}\r\n"
+                     "Content-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n".encode()
+                     + b"%x\r\n" % len(events) + events + b"\r\n0\r\n\r\n")
+        status, _, text = read_response(sock)
+    assert status == 404 and error_code(text) == "unknown_session", text[:300]

@@ -1,6 +1,7 @@
 """What keeps one client from spoiling a study for the others.
 
-* :class:`BodyGuard` (ASGI middleware): refuses a body larger than ``max_body_bytes`` before
+* :class:`BodyGuard` (ASGI middleware): refuses a request with both Content-Length and
+  Transfer-Encoding (400, ambiguous framing), refuses a body larger than ``max_body_bytes`` before
   reading it (by its Content-Length) or as soon as a streamed body passes the limit (413; the
   rest is drained, bounded, so that the client reads the 413 instead of a reset), and lets only
   strict JSON into the API: UTF-8, finite numbers, integers within ±2**53, no lone
@@ -203,6 +204,12 @@ class BodyGuard:
             await self.app(scope, receive, send)
             return
         headers = Headers(scope=scope)
+        if "transfer-encoding" in headers and "content-length" in headers:
+            # two framings: a proxy in front may have read the body by the other one (request
+            # smuggling), so neither is trusted
+            await self._refuse_unread(headers, receive, send, 400, "ambiguous_framing",
+                                      "the request has both Content-Length and Transfer-Encoding; send one")
+            return
         limit = self.max_body_bytes
         too_large = f"the request body is larger than {limit} bytes"
         declared = headers.get("content-length")
