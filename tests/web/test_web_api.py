@@ -269,3 +269,47 @@ def test_stopping_the_server_cancels_sessions_in_progress(live_server):
     log = [json.loads(x) for x in (srv.session_dir(sid) / "events.jsonl").read_text().splitlines()]
     assert log[-1]["type"] == "session_cancelled"
     assert read_rounds(srv.session_dir(sid) / "rounds.jsonl") == []
+
+
+def test_request_bodies_take_exact_types_not_lookalikes(live_server):
+    """``{"seed": true}`` is not seed 1, ``"yes"`` is not consent and ``1.0`` is not round 1:
+    each is a 422 naming the field, and nothing is started or stored."""
+    srv = live_server("bayes-stop", rounds=1, seed=4, video_size=(64, 64))
+    api = f"{srv.url}/api"
+    with httpx.Client(timeout=60) as http:
+        for body, field in [({"seed": True}, "seed"), ({"seed": False}, "seed"), ({"seed": 1.0}, "seed"),
+                            ({"seed": "3"}, "seed"), ({"participant": 7}, "participant"),
+                            ({"consent": "yes"}, "consent"), ({"consent": 1}, "consent"), ({"pid": 12345}, "pid")]:
+            res = http.post(f"{api}/sessions", json=body)
+            assert res.status_code == 422, (body, res.text)
+            err = res.json()["error"]
+            assert err["code"] == "invalid_request" and field in [f["loc"] for f in err["fields"]], (body, err)
+        assert srv.manager.all() == [], "a refused request started a session"
+        created = http.post(f"{api}/sessions", json={"seed": 3})
+        assert created.status_code == 201, created.text
+        sid = created.json()["id"]
+        assert srv.manager.get(sid).seed == 3
+        waiting_state(srv.url, sid, 1)
+        folder = srv.session_dir(sid)
+        before = snapshot(folder)
+        lookalikes = [
+            ("answer", {"kind": "stop", "round": True, "action": "looks_good"}, "round"),
+            ("answer", {"kind": "stop", "round": 1.0, "action": "looks_good"}, "round"),
+            ("answer", {"kind": "stop", "round": "1", "action": "looks_good"}, "round"),
+            ("answer", {"kind": "stop", "round": 1, "action": "stop", "time": True}, "time"),
+            ("answer", {"kind": "stop", "round": 1, "action": "looks_good", "client_ts": True}, "client_ts"),
+            ("events", {"events": [{"type": "x", "client_ts": True}]}, "client_ts"),
+            ("events", {"events": [{"type": "x", "client_ts": 1.5, "round": True}]}, "round"),
+            ("video", {"round": True, "event": "ready"}, "round"),
+            ("video", {"round": 1, "event": "ready", "media_time": False}, "media_time"),
+        ]
+        for path, body, field in lookalikes:
+            res = http.post(f"{api}/sessions/{sid}/{path}", json=body)
+            assert res.status_code == 422, (path, body, res.text)
+            err = res.json()["error"]
+            assert err["code"] == "invalid_request" and any(f["loc"].endswith(field) for f in err["fields"]), err
+        assert snapshot(folder) == before, "a refused request changed the saved data"
+        # whole numbers where seconds are asked for are still numbers
+        ok = http.post(f"{api}/sessions/{sid}/answer",
+                       json={"kind": "stop", "round": 1, "action": "looks_good", "client_ts": 1700000000})
+        assert ok.status_code == 200, ok.text

@@ -46,7 +46,8 @@ PAGES = {"/": "index.html", "/preference": "preference.html", "/clicker": "click
 
 # -- request bodies ---------------------------------------------------------------------------
 # Every body forbids fields it does not know and bounds every number: a typo or a probe is a
-# 422, never something silently ignored or stored.
+# 422, never something silently ignored or stored. Types are strict: true is not 1, "yes" is not
+# true and 1.0 is not round 1 (pydantic would convert each); a whole number still counts as seconds.
 MAX_ROUND = 10_000
 
 
@@ -55,7 +56,7 @@ def _client_ts():
 
 
 class _Body(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", strict=True)
 
 
 def _url_id(what: str):
