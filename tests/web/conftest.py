@@ -109,6 +109,14 @@ def live_server(tmp_path) -> Iterator:
         thread.join(30)
 
 
+@pytest.fixture
+def http() -> Iterator[httpx.Client]:
+    """A client that keeps cookies, as a browser does: a session's key comes back as one, and
+    only requests that carry it may answer that session."""
+    with httpx.Client(timeout=120) as c:
+        yield c
+
+
 @pytest.fixture(scope="session")
 def browser():
     if not Path(CHROMIUM).exists():
