@@ -3,8 +3,8 @@
 * :class:`BodyGuard` (ASGI middleware): refuses a request with both Content-Length and
   Transfer-Encoding (400, ambiguous framing), refuses a body larger than ``max_body_bytes`` before
   reading it (by its Content-Length) or as soon as a streamed body passes the limit (413; the
-  rest is drained, bounded, so that the client reads the 413 instead of a reset), and lets only
-  strict JSON into the API: UTF-8, finite numbers, integers within ±2**53, no lone
+  rest is drained, bounded, so that the client reads the 413 instead of a reset), gives a body
+  ``body_timeout`` s to arrive (408), and lets only strict JSON into the API: UTF-8, finite numbers, integers within ±2**53, no lone
   surrogates, no duplicate keys, nesting at most 32 deep (422; 415 for a non-JSON type).
 * :class:`SessionLimits`: admission of new sessions (at most ``max_sessions_per_client`` in
   progress per client address, ``max_new_sessions_per_hour`` started per client address per
@@ -12,7 +12,9 @@
   has asked about for ``idle_timeout`` seconds (so an abandoned tab frees its slot), and the
   quota on what clients may write into a session's ``events.jsonl``.
 
-Time comes from an injectable clock so that expiry can be tested without waiting.
+Time comes from an injectable clock so that expiry can be tested without waiting. What is
+bounded below the app (request heads, connections per address and in all) is in
+:mod:`activeintent.web.transport`.
 """
 
 from __future__ import annotations
@@ -56,6 +58,12 @@ class Limits(BaseModel):
         "sender can read the refusal; a larger body's sender may see the connection reset instead")
     body_timeout: float = Field(
         30.0, gt=0, description="seconds for a request body to arrive (and for draining a refused one)")
+    header_timeout: float = Field(
+        10.0, gt=0, description="seconds for a request head to arrive on a new or idle connection")
+    max_connections_per_client: int = Field(32, ge=1, description="connections open at once from one address")
+    max_connections: int = Field(
+        1000, ge=8, description="connections open at once in all (never more than the file-descriptor "
+        "limit leaves after a reserve for the sessions)")
     events_quota_bytes: int = Field(
         5 * 1024 * 1024, ge=1024, description="largest events.jsonl clients may fill in one session"
     )
@@ -163,6 +171,7 @@ class BodyGuard:
 
     def __init__(self, app: ASGIApp, max_body_bytes: int, json_prefix: str = "/api/",
                  drain_bytes: int = 16 * 2**20, drain_timeout: float = 30.0):
+        # drain_timeout also bounds reading a body that is not refused (408 past it)
         self.app, self.max_body_bytes, self.json_prefix = app, max_body_bytes, json_prefix
         self.drain_bytes, self.drain_timeout = drain_bytes, drain_timeout
 
@@ -218,23 +227,31 @@ class BodyGuard:
             await self._refuse_unread(headers, receive, send, 413, "body_too_large", too_large)
             return
         chunks: list[bytes] = []
-        size = 0
-        while True:
-            message = await receive()
-            if message["type"] != "http.request":  # the client went away
-                return
-            chunk = message.get("body", b"")
-            size += len(chunk)
-            if size > limit:
-                more = message.get("more_body", False)
-                if more:
-                    await self._refuse_unread(headers, receive, send, 413, "body_too_large", too_large, read=size)
-                else:
-                    await self._refuse(scope, receive, send, 413, "body_too_large", too_large, close=True)
-                return
-            chunks.append(chunk)
-            if not message.get("more_body", False):
-                break
+        size, more, over = 0, True, False
+        try:
+            # a body that trickles in holds a connection and a task: it has body_timeout s in all
+            async with asyncio.timeout(self.drain_timeout):
+                while more:
+                    message = await receive()
+                    if message["type"] != "http.request":  # the client went away
+                        return
+                    chunk = message.get("body", b"")
+                    size += len(chunk)
+                    more = message.get("more_body", False)
+                    if size > limit:
+                        over = True
+                        break
+                    chunks.append(chunk)
+        except TimeoutError:
+            await self._refuse(scope, receive, send, 408, "request_timeout",
+                               f"the request body did not arrive within {self.drain_timeout:g} s", close=True)
+            return
+        if over:
+            if more:
+                await self._refuse_unread(headers, receive, send, 413, "body_too_large", too_large, read=size)
+            else:
+                await self._refuse(scope, receive, send, 413, "body_too_large", too_large, close=True)
+            return
         body = b"".join(chunks)
         if body and scope["path"].startswith(self.json_prefix) and scope["method"] in ("POST", "PUT", "PATCH"):
             if not _json_type(headers.get("content-type")):

@@ -38,6 +38,7 @@ from activeintent.web.session import (
     new_session_key,
 )
 from activeintent.web.study import PID_RULE, URL_PARAMETERS, StudyFile, check_pid
+from activeintent.web.transport import ConnectionGuard, RequestPhases
 
 STATIC = Path(__file__).parent / "static"
 MAX_FILE_NAME = 64  # longer than any video name the server writes
@@ -296,6 +297,12 @@ def create_app(
     install_error_handlers(app)
     app.add_middleware(BodyGuard, max_body_bytes=limits.max_body_bytes, drain_bytes=limits.drain_bytes,
                        drain_timeout=limits.body_timeout)
+    # outermost: a request's connection learns when its head is complete (see web/transport.py)
+    connections = ConnectionGuard(header_timeout=limits.header_timeout,
+                                  max_connections_per_client=limits.max_connections_per_client,
+                                  max_connections=limits.max_connections)
+    app.state.connections = connections
+    app.add_middleware(RequestPhases, guard=connections)
 
     def session_or_404(sid: str) -> WebSession:
         session = manager.get(sid)
