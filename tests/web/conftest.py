@@ -12,12 +12,12 @@ from pathlib import Path
 
 import httpx
 import pytest
-import uvicorn
 
 from activeintent.learners.registry import get_method
 from activeintent.web.limits import Limits, SessionLimits
 from activeintent.web.server import create_app, runner_builder
 from activeintent.web.session import SessionManager, StudyConfig
+from activeintent.web.transport import StudyServer, server_config
 
 CHROMIUM = os.environ.get("ACTIVEINTENT_CHROMIUM", "/usr/bin/chromium")
 CHROMIUM_ARGS = [
@@ -72,7 +72,7 @@ def _free_port() -> int:
 def live_server(tmp_path) -> Iterator:
     """``start(method, rounds=2, limits=None, clock=None, **study)`` serves a study on
     127.0.0.1 for this test (``limits``: a :class:`Limits` or its fields as a dict)."""
-    servers: list[tuple[uvicorn.Server, threading.Thread]] = []
+    servers: list[tuple[StudyServer, threading.Thread]] = []
 
     def start(method: str, rounds: int = 2, limits: Limits | dict | None = None, clock=None, study_file=None,
               **study) -> LiveServer:
@@ -90,7 +90,8 @@ def live_server(tmp_path) -> Iterator:
         app = create_app(config, runner_builder(config, llm="none", test_scenes=2),  # Bayesian methods, no model
                          limits=limits, clock=clock or time.monotonic, study=study_file, conditions=conditions)
         port = _free_port()
-        server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
+        # the server `activeintent serve` runs: uvicorn inside the connection guard
+        server = StudyServer(server_config(app, "127.0.0.1", port), app.state.connections)
         thread = threading.Thread(target=server.run, daemon=True)
         thread.start()
         url = f"http://127.0.0.1:{port}"
@@ -107,6 +108,14 @@ def live_server(tmp_path) -> Iterator:
     for server, thread in servers:
         server.should_exit = True
         thread.join(30)
+
+
+@pytest.fixture
+def http() -> Iterator[httpx.Client]:
+    """A client that keeps cookies, as a browser does: a session's key comes back as one, and
+    only requests that carry it may answer that session."""
+    with httpx.Client(timeout=120) as c:
+        yield c
 
 
 @pytest.fixture(scope="session")

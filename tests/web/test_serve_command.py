@@ -27,10 +27,10 @@ def test_bad_options_fail_before_serving_and_list_the_valid_ones(tmp_path):
 
 
 def test_serve_names_the_design_and_configures_the_study(tmp_path, monkeypatch):
-    import uvicorn
+    from activeintent.web import transport
 
     served = []
-    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: served.append(app))
+    monkeypatch.setattr(transport, "serve", lambda app, **kw: served.append(app))
     runner = CliRunner()
     res = runner.invoke(app, ["serve", "--method", "bayes-stop", "--out", str(tmp_path)])
     assert res.exit_code == 0, res.output
@@ -99,10 +99,10 @@ def _tcp_listeners() -> list[tuple[str, int]]:
 
 
 def test_serve_loads_a_study_file(tmp_path, monkeypatch):
-    import uvicorn
+    from activeintent.web import transport
 
     served = []
-    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: served.append(app))
+    monkeypatch.setattr(transport, "serve", lambda app, **kw: served.append(app))
     study = tmp_path / "study.toml"
     study.write_text('consent = "Agree?"\ncompletion_code = "C1"\n\n[[conditions]]\nname = "pref"\n'
                      'method = "bayes-preference"\nintention = "color-match"\n\n[[conditions]]\nname = "stop"\n'

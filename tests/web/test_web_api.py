@@ -53,10 +53,10 @@ def raw_get(url: str, path: str) -> tuple[int, str]:
         conn.close()
 
 
-def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server):
+def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server, http):
     srv = live_server("bayes-preference", rounds=2, seed=5, video_size=(128, 128))
     api = f"{srv.url}/api"
-    created = httpx.post(f"{api}/sessions", json={"participant": "api-test"})
+    created = http.post(f"{api}/sessions", json={"participant": "api-test"})
     assert created.status_code == 201
     sid = created.json()["id"]
     state = waiting_state(srv.url, sid, 1)
@@ -86,25 +86,25 @@ def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server)
         ([1, 2, 3], 422, "invalid request"),
     ]
     for body, status, message in bad:
-        res = httpx.post(answer, json=body)
+        res = http.post(answer, json=body)
         assert res.status_code == status, (body, res.text)
         assert message in res.json()["error"]["message"], (body, res.json())
-    res = httpx.post(answer, content=b"{not json", headers={"content-type": "application/json"})
+    res = http.post(answer, content=b"{not json", headers={"content-type": "application/json"})
     assert res.status_code == 422 and "JSON" in res.json()["error"]["message"]
     assert snapshot(folder) == before, "a rejected answer changed the saved data"
 
-    ok = httpx.post(answer, json={"kind": "preference", "round": 1, "choice": "B", "client_ts": 1.0})
+    ok = http.post(answer, json={"kind": "preference", "round": 1, "choice": "B", "client_ts": 1.0})
     assert ok.status_code == 200 and ok.json()["answer"]["choice"] == "B"
     rounds = wait_for(lambda: read_rounds(folder / "rounds.jsonl"), what="rounds.jsonl")
     assert rounds[0]["answer"] == {"signal": "preference", "new_scene": False, "choice": "B"}
 
     # the same answer again (a replay) is refused and the log keeps one round
     after = snapshot(folder)
-    replay = httpx.post(answer, json={"kind": "preference", "round": 1, "choice": "A"})
+    replay = http.post(answer, json={"kind": "preference", "round": 1, "choice": "A"})
     assert replay.status_code == 409
     assert "round 1" in replay.json()["error"]["message"]
     waiting_state(srv.url, sid, 2)
-    replay = httpx.post(answer, json={"kind": "preference", "round": 1, "choice": "A"})
+    replay = http.post(answer, json={"kind": "preference", "round": 1, "choice": "A"})
     assert replay.status_code == 409 and "waiting for round 2" in replay.json()["error"]["message"]
     assert read_rounds(folder / "rounds.jsonl") == rounds
     assert (folder / "rounds.jsonl").read_bytes() == after["rounds.jsonl"]
@@ -114,10 +114,10 @@ def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server)
     assert res.status_code == 409 and "no result yet" in res.json()["error"]["message"]
 
 
-def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server):
+def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server, http):
     srv = live_server("bayes-stop", rounds=1, seed=2, video_size=(128, 128))
     api = f"{srv.url}/api"
-    sid = httpx.post(f"{api}/sessions").json()["id"]
+    sid = http.post(f"{api}/sessions").json()["id"]
     state = waiting_state(srv.url, sid, 1)
     video = state["question"]["videos"][0]
     assert video["fps"] == 10 and video["frames"] >= 2
@@ -127,11 +127,11 @@ def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server):
     answer = f"{api}/sessions/{sid}/answer"
     outside = [-0.5, video["duration"] + 0.5, 1e9]
     for t in outside:
-        res = httpx.post(answer, json={"kind": "stop", "round": 1, "action": "stop", "time": t})
+        res = http.post(answer, json={"kind": "stop", "round": 1, "action": "stop", "time": t})
         assert res.status_code == 422 and "outside the video" in res.json()["error"]["message"], res.text
     for raw in (b"NaN", b"Infinity", b"-Infinity", b'"soon"'):
         body = b'{"kind": "stop", "round": 1, "action": "stop", "time": ' + raw + b"}"
-        res = httpx.post(answer, content=body, headers={"content-type": "application/json"})
+        res = http.post(answer, content=body, headers={"content-type": "application/json"})
         assert res.status_code == 422, (raw, res.text)
         assert "time" in res.json()["error"]["message"]
     for body, message in [
@@ -140,12 +140,12 @@ def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server):
         ({"kind": "stop", "round": 1, "action": "halt", "time": 1.0}, "'stop', 'looks_good' or 'new_scene'"),
         ({"kind": "preference", "round": 1, "choice": "A"}, "asks for stop answers"),
     ]:
-        res = httpx.post(answer, json=body)
+        res = http.post(answer, json=body)
         assert res.status_code == 422 and message in res.json()["error"]["message"], (body, res.text)
     assert snapshot(folder) == before
 
     t = 0.45  # media time → trajectory time 0.45 s: frame 4, tick round(0.45 / dt)
-    res = httpx.post(answer, json={"kind": "stop", "round": 1, "action": "stop", "time": t})
+    res = http.post(answer, json={"kind": "stop", "round": 1, "action": "stop", "time": t})
     assert res.status_code == 200, res.text
     h = res.json()["answer"]
     assert h["stop_time"] == pytest.approx(t) and h["frame"] == 4
@@ -161,19 +161,19 @@ def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server):
 
     # a finished session takes no answers; its saved data stays as it is
     done = snapshot(folder)
-    res = httpx.post(answer, json={"kind": "stop", "round": 2, "action": "looks_good"})
+    res = http.post(answer, json={"kind": "stop", "round": 2, "action": "looks_good"})
     assert res.status_code == 409 and "finished" in res.json()["error"]["message"]
     assert snapshot(folder) == done
 
 
-def test_unknown_sessions_path_traversal_and_isolation(live_server):
+def test_unknown_sessions_path_traversal_and_isolation(live_server, http):
     srv = live_server("bayes-preference", rounds=2, seed=1, max_sessions=2, video_size=(128, 128),
                       limits={"max_sessions_per_client": 3})
     api = f"{srv.url}/api"
-    a = httpx.post(f"{api}/sessions").json()["id"]
-    b = httpx.post(f"{api}/sessions").json()["id"]
+    a = http.post(f"{api}/sessions").json()["id"]
+    b = http.post(f"{api}/sessions").json()["id"]
     assert a != b
-    full = httpx.post(f"{api}/sessions")
+    full = http.post(f"{api}/sessions")
     assert full.status_code == 503 and "limit 2" in full.json()["error"]["message"]
     assert full.json()["error"]["code"] == "server_full" and int(full.headers["retry-after"]) > 0
     waiting_state(srv.url, a, 1)
@@ -181,7 +181,7 @@ def test_unknown_sessions_path_traversal_and_isolation(live_server):
     before_b = snapshot(srv.session_dir(b))
 
     # answering session a leaves session b waiting for its own round 1
-    res = httpx.post(f"{api}/sessions/{a}/answer", json={"kind": "preference", "round": 1, "choice": "A"})
+    res = http.post(f"{api}/sessions/{a}/answer", json={"kind": "preference", "round": 1, "choice": "A"})
     assert res.status_code == 200
     waiting_state(srv.url, a, 2)
     state_b = httpx.get(f"{api}/sessions/{b}").json()
@@ -196,7 +196,7 @@ def test_unknown_sessions_path_traversal_and_isolation(live_server):
             ("GET", f"/sessions/{sid}/result", None),
             ("POST", f"/sessions/{sid}/questionnaire", {"final_attempt": "yes", "rule": "mine"}),
         ]:
-            res = httpx.request(method, api + path, json=body)
+            res = http.request(method, api + path, json=body)
             assert res.status_code == 404, (method, path, res.text)
             assert "unknown session" in res.json()["error"]["message"]
 
@@ -229,7 +229,7 @@ def test_unknown_sessions_path_traversal_and_isolation(live_server):
         assert "not for participants" not in text and "root:" not in text and "import" not in text
 
     # the events of a session go to its own events.jsonl only
-    res = httpx.post(f"{api}/sessions/{b}/events",
+    res = http.post(f"{api}/sessions/{b}/events",
                      json={"events": [{"type": "probe", "client_ts": 1234.5, "round": 1, "data": {"k": 1}}]})
     assert res.status_code == 200 and res.json() == {"logged": 1}
     events_b = [json.loads(x) for x in (srv.session_dir(b) / "events.jsonl").read_text().splitlines()]
@@ -239,7 +239,7 @@ def test_unknown_sessions_path_traversal_and_isolation(live_server):
     assert not [e for e in events_a if e["type"] == "probe"]
     for body in ({"events": []}, {"events": [{"type": "", "client_ts": 1}]},
                  {"events": [{"type": "x", "client_ts": 1, "data": {"blob": "x" * 5000}}]}):
-        res = httpx.post(f"{api}/sessions/{b}/events", json=body)
+        res = http.post(f"{api}/sessions/{b}/events", json=body)
         assert res.status_code == 422, res.text
 
 
@@ -257,15 +257,124 @@ def test_openapi_describes_the_api(live_server):
                       "video_size": [480, 480]}
 
 
-def test_stopping_the_server_cancels_sessions_in_progress(live_server):
+def test_stopping_the_server_cancels_sessions_in_progress(live_server, http):
     srv = live_server("bayes-stop", rounds=2, seed=6, video_size=(128, 128))
-    sid = httpx.post(f"{srv.url}/api/sessions").json()["id"]
+    sid = http.post(f"{srv.url}/api/sessions").json()["id"]
     waiting_state(srv.url, sid, 1)
     srv.manager.shutdown(timeout=60)  # what the app's lifespan does when uvicorn stops
     session = srv.manager.get(sid)
     assert not session.active and session.status == "cancelled" and "server stopped" in session.error
-    res = httpx.post(f"{srv.url}/api/sessions/{sid}/answer", json={"kind": "stop", "round": 1, "action": "looks_good"})
+    res = http.post(f"{srv.url}/api/sessions/{sid}/answer", json={"kind": "stop", "round": 1, "action": "looks_good"})
     assert res.status_code == 409 and "cancelled" in res.json()["error"]["message"]
     log = [json.loads(x) for x in (srv.session_dir(sid) / "events.jsonl").read_text().splitlines()]
     assert log[-1]["type"] == "session_cancelled"
     assert read_rounds(srv.session_dir(sid) / "rounds.jsonl") == []
+
+
+def test_request_bodies_take_exact_types_not_lookalikes(live_server):
+    """``{"seed": true}`` is not seed 1, ``"yes"`` is not consent and ``1.0`` is not round 1:
+    each is a 422 naming the field, and nothing is started or stored."""
+    srv = live_server("bayes-stop", rounds=1, seed=4, video_size=(64, 64))
+    api = f"{srv.url}/api"
+    with httpx.Client(timeout=60) as http:
+        for body, field in [({"seed": True}, "seed"), ({"seed": False}, "seed"), ({"seed": 1.0}, "seed"),
+                            ({"seed": "3"}, "seed"), ({"participant": 7}, "participant"),
+                            ({"consent": "yes"}, "consent"), ({"consent": 1}, "consent"), ({"pid": 12345}, "pid")]:
+            res = http.post(f"{api}/sessions", json=body)
+            assert res.status_code == 422, (body, res.text)
+            err = res.json()["error"]
+            assert err["code"] == "invalid_request" and field in [f["loc"] for f in err["fields"]], (body, err)
+        assert srv.manager.all() == [], "a refused request started a session"
+        created = http.post(f"{api}/sessions", json={"seed": 3})
+        assert created.status_code == 201, created.text
+        sid = created.json()["id"]
+        assert srv.manager.get(sid).seed == 3
+        waiting_state(srv.url, sid, 1)
+        folder = srv.session_dir(sid)
+        before = snapshot(folder)
+        lookalikes = [
+            ("answer", {"kind": "stop", "round": True, "action": "looks_good"}, "round"),
+            ("answer", {"kind": "stop", "round": 1.0, "action": "looks_good"}, "round"),
+            ("answer", {"kind": "stop", "round": "1", "action": "looks_good"}, "round"),
+            ("answer", {"kind": "stop", "round": 1, "action": "stop", "time": True}, "time"),
+            ("answer", {"kind": "stop", "round": 1, "action": "looks_good", "client_ts": True}, "client_ts"),
+            ("events", {"events": [{"type": "x", "client_ts": True}]}, "client_ts"),
+            ("events", {"events": [{"type": "x", "client_ts": 1.5, "round": True}]}, "round"),
+            ("video", {"round": True, "event": "ready"}, "round"),
+            ("video", {"round": 1, "event": "ready", "media_time": False}, "media_time"),
+        ]
+        for path, body, field in lookalikes:
+            res = http.post(f"{api}/sessions/{sid}/{path}", json=body)
+            assert res.status_code == 422, (path, body, res.text)
+            err = res.json()["error"]
+            assert err["code"] == "invalid_request" and any(f["loc"].endswith(field) for f in err["fields"]), err
+        assert snapshot(folder) == before, "a refused request changed the saved data"
+        # whole numbers where seconds are asked for are still numbers
+        ok = http.post(f"{api}/sessions/{sid}/answer",
+                       json={"kind": "stop", "round": 1, "action": "looks_good", "client_ts": 1700000000})
+        assert ok.status_code == 200, ok.text
+
+
+def test_a_session_takes_answers_only_from_the_browser_that_started_it(live_server):
+    """The session id is in the page's URL; the key cookie set when the session starts is what
+    lets a request answer, and every stored answer says who gave it."""
+    import hashlib
+
+    srv = live_server("bayes-stop", rounds=1, seed=7, video_size=(64, 64))
+    api = f"{srv.url}/api"
+
+    def client(address: str) -> httpx.Client:
+        return httpx.Client(transport=httpx.HTTPTransport(local_address=address), timeout=60)
+
+    with client("127.0.0.1") as owner, client("127.0.0.2") as stranger:
+        created = owner.post(f"{api}/sessions", json={"participant": "P-owner"})
+        assert created.status_code == 201, created.text
+        sid = created.json()["id"]
+        (cookie,) = created.headers.get_list("set-cookie")
+        attributes = [a.strip().lower() for a in cookie.split(";")]
+        name, _, key = attributes[0].partition("=")
+        assert name == "activeintent_key" and len(key) >= 43  # 256 random bits, URL-safe base64
+        assert "httponly" in attributes and "samesite=strict" in attributes
+        assert f"path=/api/sessions/{sid}" in attributes
+        key = cookie.split(";")[0].partition("=")[2]
+        waiting_state(srv.url, sid, 1)
+        folder = srv.session_dir(sid)
+        before = snapshot(folder)
+
+        other = stranger.post(f"{api}/sessions", json={"participant": "P-other"}).json()["id"]
+        other_key = stranger.cookies.get("activeintent_key", path=f"/api/sessions/{other}")
+        looks_good = {"kind": "stop", "round": 1, "action": "looks_good"}
+        attempts = [
+            (stranger, {}),  # no key at all
+            (stranger, {"Cookie": "activeintent_key=" + "A" * 43}),  # a guessed one
+            (stranger, {"Cookie": f"activeintent_key={other_key}"}),  # the key of another session
+            (httpx, {"Cookie": f"activeintent_key={key[:-1]}"}),  # almost the right one
+        ]
+        for c, headers in attempts:
+            for path, body in [("answer", looks_good), ("video", {"round": 1, "event": "ready"}),
+                               ("events", {"events": [{"type": "x", "client_ts": 1.7e9}]}),
+                               ("questionnaire", {"final_attempt": "yes", "rule": "mine"}),
+                               ("answer", {"kind": "stop", "round": "bad"})]:  # refused before validation
+                res = c.post(f"{api}/sessions/{sid}/{path}", json=body, headers=headers)
+                assert res.status_code == 403, (path, headers, res.text)
+                err = res.json()["error"]
+                assert err["code"] == "not_session_owner" and "browser that started it" in err["message"]
+        assert snapshot(folder) == before, "a refused request changed the saved data"
+        assert stranger.get(f"{api}/sessions/{sid}").status_code == 200  # reading needs only the id
+
+        ok = owner.post(f"{api}/sessions/{sid}/answer", json=looks_good)
+        assert ok.status_code == 200, ok.text
+        session = srv.manager.get(sid)
+        assert session.join(300) and session.status == "finished", session.error
+        q = owner.post(f"{api}/sessions/{sid}/questionnaire", json={"final_attempt": "no", "rule": "mine"})
+        assert q.status_code == 201, q.text
+
+    key_id = hashlib.sha256(key.encode()).hexdigest()[:16]
+    by = {"participant": "P-owner", "key": key_id, "address": "127.0.0.1"}
+    info = json.loads((folder / "session.json").read_text())
+    assert info["key_id"] == key_id and key not in (folder / "session.json").read_text()
+    log = [json.loads(x) for x in (folder / "events.jsonl").read_text().splitlines()]
+    assert [e["answered_by"] for e in log if e["type"] == "answer"] == [by]
+    assert [r["answered_by"] for r in read_rounds(folder / "rounds.jsonl")] == [by]
+    assert json.loads((folder / "questionnaire.json").read_text())["answered_by"] == by
+    assert all(key not in p.read_text(errors="replace") for p in folder.iterdir() if p.suffix in (".json", ".jsonl"))

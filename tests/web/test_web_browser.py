@@ -358,6 +358,10 @@ def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
     session = srv.manager.get(sid)
     assert session.enrolment.condition == expected
     assert session.config.show_estimate == study.condition(expected).show_estimate
+    # the browser holds the session's key: for this session's API only, out of the page's reach
+    (key,) = [c for c in page.context.cookies() if c["name"] == "activeintent_key"]
+    assert key["path"] == f"/api/sessions/{sid}" and key["httpOnly"] and key["sameSite"] == "Strict"
+    assert "activeintent_key" not in page.evaluate("document.cookie")
 
     # -- round 1: ready gate, the video ends, a late Stop, a stop in the replay --------------------
     wait_round(page, 1)
@@ -382,11 +386,14 @@ def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
             break
         page.wait_for_timeout(50)
     assert session.viewing(1)["ended"] is not None, "the page did not report the video's end"
-    late = httpx.post(f"{api}/answer", json={"kind": "stop", "round": 1, "action": "stop", "time": 1.0})
-    assert late.status_code == 422 and late.json()["error"]["code"] == "after_video_end"
-    at_end = httpx.post(f"{api}/answer", json={"kind": "stop", "round": 1, "action": "stop",
-                                               "time": video["duration"], "viewing": "replay"})
-    assert at_end.status_code == 422 and "at or after the end" in at_end.json()["error"]["message"]
+    # (sent with the browser's cookies, as the page would send them; without them: refused)
+    stop = {"kind": "stop", "round": 1, "action": "stop", "time": 1.0}
+    assert httpx.post(f"{api}/answer", json=stop).json()["error"]["code"] == "not_session_owner"
+    late = page.request.post(f"{api}/answer", data=stop)
+    assert late.status == 422 and late.json()["error"]["code"] == "after_video_end"
+    at_end = page.request.post(f"{api}/answer", data={"kind": "stop", "round": 1, "action": "stop",
+                                                      "time": video["duration"], "viewing": "replay"})
+    assert at_end.status == 422 and "at or after the end" in at_end.json()["error"]["message"]
     page.click("#replay")
     page.wait_for_selector('#question[data-phase="replay"]')
     target = (int(0.4 * (video["frames"] - 1)) + 0.5) / video["fps"]
@@ -442,6 +449,11 @@ def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
     assert row["round1_answer"] == "stop" and row["round1_viewing"] == "replay"
     assert row["round1_after_end_presses"] == "3" and row["round2_answer"] == "looks_good"
     assert float(row["round1_stop_time"]) == pytest.approx(target, abs=1e-3)
+    # one participant: the link's pid, proved by the key cookie of the browser that consented
+    assert row["key_id"] == info["key_id"] == row["round1_key"] == row["round2_key"]
+    by = {"participant": "P-study-01", "key": info["key_id"], "address": "127.0.0.1"}
+    assert [r["answered_by"] for r in read_rounds(folder / "rounds.jsonl")] == [by, by]
+    assert json.loads((folder / "questionnaire.json").read_text())["answered_by"] == by
     # no stop time at or after the video's end
     for r in read_rounds(folder / "rounds.jsonl"):
         assert r["answer"]["stop_time"] is None or r["answer"]["stop_time"] < video["duration"] - 1e-9

@@ -8,10 +8,10 @@ import time
 
 import httpx
 import pytest
-import uvicorn
 from typer.testing import CliRunner
 
 from activeintent.cli import app as cli
+from activeintent.web import transport
 
 pytestmark = pytest.mark.slow  # real episodes
 
@@ -101,11 +101,12 @@ def test_a_client_may_start_only_so_many_sessions_per_hour(live_server, fake_clo
 
 def test_serve_options_set_the_limits(tmp_path, monkeypatch):
     served = {}
-    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: served.update(app=app, **kw))
+    monkeypatch.setattr(transport, "serve", lambda app, **kw: served.update(app=app, **kw))
     res = CliRunner().invoke(cli, [
         "serve", "--method", "bayes-stop", "--llm", "none", "--out", str(tmp_path / "study"),
         "--max-sessions", "3", "--max-sessions-per-client", "1", "--max-new-sessions-per-hour", "7",
         "--idle-timeout", "2.5", "--max-request-kb", "8", "--events-quota-mb", "0.5",
+        "--header-timeout", "4", "--body-timeout", "6", "--max-connections-per-client", "5", "--max-connections", "50",
     ])
     assert res.exit_code == 0, res.output
     limits = served["app"].state.limits
@@ -113,7 +114,12 @@ def test_serve_options_set_the_limits(tmp_path, monkeypatch):
     assert limits.limits.max_sessions_per_client == 1 and limits.limits.max_new_sessions_per_hour == 7
     assert limits.limits.idle_timeout == 150.0
     assert limits.limits.max_body_bytes == 8 * 1024 and limits.limits.events_quota_bytes == 512 * 1024
-    for bad in (["--max-sessions-per-client", "0"], ["--idle-timeout", "0"], ["--max-request-kb", "0"]):
+    assert limits.limits.body_timeout == 6.0
+    connections = served["app"].state.connections
+    assert connections.header_timeout == 4.0 and connections.per_client == 5
+    assert connections.max_connections <= 50  # and below the file-descriptor limit
+    for bad in (["--max-sessions-per-client", "0"], ["--idle-timeout", "0"], ["--max-request-kb", "0"],
+                ["--header-timeout", "0"], ["--max-connections-per-client", "0"], ["--max-connections", "2"]):
         res = CliRunner().invoke(cli, ["serve", "--method", "bayes-stop", "--out", str(tmp_path / "x"), *bad])
         assert res.exit_code != 0, bad
     assert not (tmp_path / "x").exists()

@@ -161,13 +161,13 @@ def _waiting(url: str, sid: str, n: int) -> dict:
 
 
 @pytest.mark.slow
-def test_free_rule_session_questionnaire_and_guess_shown_always(live_server):
+def test_free_rule_session_questionnaire_and_guess_shown_always(live_server, http):
     srv = live_server("bayes-stop", rounds=2, seed=2, video_size=(64, 64), show_estimate="always")
     api = f"{srv.url}/api"
     config = httpx.get(f"{api}/config").json()
     assert config["design"] == "free-rule" and config["intention"] is None
     assert config["intention_description"] is None and config["show_estimate"] == "always"
-    sid = httpx.post(f"{api}/sessions", json={"participant": "P-free"}).json()["id"]
+    sid = http.post(f"{api}/sessions", json={"participant": "P-free"}).json()["id"]
     folder = srv.session_dir(sid)
     q = f"{api}/sessions/{sid}/questionnaire"
 
@@ -175,13 +175,13 @@ def test_free_rule_session_questionnaire_and_guess_shown_always(live_server):
     assert state["estimate"] is None  # never a guess before the first answer, whatever the study says
     assert [o["name"] for o in state["question"]["legend"]] == state["question"]["scene"]
     assert state["questionnaire"] == {"open": False, "submitted": False, "asks_final_attempt": False}
-    early = httpx.post(q, json={"final_attempt": "yes", "rule": "mine"})
+    early = http.post(q, json={"final_attempt": "yes", "rule": "mine"})
     assert early.status_code == 409 and "after the robot's final attempt" in early.json()["error"]["message"]
-    httpx.post(f"{api}/sessions/{sid}/answer", json={"kind": "stop", "round": 1, "action": "looks_good"})
+    http.post(f"{api}/sessions/{sid}/answer", json={"kind": "stop", "round": 1, "action": "looks_good"})
     state = _waiting(srv.url, sid, 2)
     guess = state["estimate"]
     assert guess["answers"] == 1 and guess["z"] and 0 <= guess["confidence"] <= 1  # a Bayesian learner's belief
-    httpx.post(f"{api}/sessions/{sid}/answer", json={"kind": "stop", "round": 2, "action": "new_scene"})
+    http.post(f"{api}/sessions/{sid}/answer", json={"kind": "stop", "round": 2, "action": "new_scene"})
     session = srv.manager.get(sid)
     assert session.join(300) and session.status == "finished", session.error
 
@@ -213,35 +213,35 @@ def test_free_rule_session_questionnaire_and_guess_shown_always(live_server):
         ({"rule": "mine"}, "invalid_answer", "final_attempt is required"),
     ]
     for body, code, message in bad:
-        res = httpx.post(q, json=body)
+        res = http.post(q, json=body)
         assert res.status_code == 422, (body, res.text)
         assert res.json()["error"]["code"] == code and message in res.json()["error"]["message"], res.json()
     assert sorted(p.name for p in folder.iterdir()) == before, "a refused questionnaire was saved"
 
-    ok = httpx.post(q, json={"final_attempt": "partly", "rule": "  Blocks near bowls\nof their colour ",
+    ok = http.post(q, json={"final_attempt": "partly", "rule": "  Blocks near bowls\nof their colour ",
                              "comments": "", "client_ts": 1.7e9})
     assert ok.status_code == 201, ok.text
     saved = json.loads((folder / "questionnaire.json").read_text())
     assert saved["final_attempt"] == "partly" and saved["rule"] == "Blocks near bowls\nof their colour"
     assert saved["comments"] is None and saved["participant"] == "P-free" and saved["design"] == "free-rule"
-    again = httpx.post(q, json={"final_attempt": "yes", "rule": "changed my mind"})
+    again = http.post(q, json={"final_attempt": "yes", "rule": "changed my mind"})
     assert again.status_code == 409 and again.json()["error"]["code"] == "already_submitted"
     assert json.loads((folder / "questionnaire.json").read_text()) == saved
     assert httpx.get(f"{api}/sessions/{sid}").json()["questionnaire"]["submitted"]
 
 
 @pytest.mark.slow
-def test_assigned_rule_is_shown_scored_and_exported_with_hidden_guesses(live_server, tmp_path):
+def test_assigned_rule_is_shown_scored_and_exported_with_hidden_guesses(live_server, tmp_path, http):
     srv = live_server("bayes-preference", rounds=1, seed=3, video_size=(64, 64), intention="color-match")
     api = f"{srv.url}/api"
     config = httpx.get(f"{api}/config").json()
     assert config["design"] == "assigned-rule" and config["intention"] == "color-match"
     assert config["intention_description"] == "Put each block in the bowl of the same colour."
     assert config["show_estimate"] == "hidden" and config["video_size"] == [64, 64]
-    sid = httpx.post(f"{api}/sessions", json={"participant": "P-assigned"}).json()["id"]
+    sid = http.post(f"{api}/sessions", json={"participant": "P-assigned"}).json()["id"]
     state = _waiting(srv.url, sid, 1)
     assert state["design"] == "assigned-rule" and state["estimate"] is None
-    httpx.post(f"{api}/sessions/{sid}/answer", json={"kind": "preference", "round": 1, "choice": "B"})
+    http.post(f"{api}/sessions/{sid}/answer", json={"kind": "preference", "round": 1, "choice": "B"})
     session = srv.manager.get(sid)
     assert session.join(300) and session.status == "finished", session.error
     state = httpx.get(f"{api}/sessions/{sid}").json()
@@ -249,7 +249,7 @@ def test_assigned_rule_is_shown_scored_and_exported_with_hidden_guesses(live_ser
     summary = json.loads((srv.session_dir(sid) / "summary.json").read_text())
     assert summary["success_basis"] == "assigned-rule" and summary["intention"] == "color-match"
     assert summary["success"] is None or 0 <= summary["success"] <= 1
-    res = httpx.post(f"{api}/sessions/{sid}/questionnaire", json={"final_attempt": "no", "rule": "same colours"})
+    res = http.post(f"{api}/sessions/{sid}/questionnaire", json={"final_attempt": "no", "rule": "same colours"})
     assert res.status_code == 201
 
     table = tmp_path / "study.jsonl"

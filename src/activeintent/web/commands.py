@@ -54,18 +54,22 @@ def serve(
     idle_timeout: Annotated[float, typer.Option("--idle-timeout", min=0.1, help="Minutes without a request from a session's page before it is cancelled and its slot freed")] = 3.0,
     max_request_kb: Annotated[int, typer.Option("--max-request-kb", min=1, help="Largest request body in KiB")] = 128,
     events_quota_mb: Annotated[float, typer.Option("--events-quota-mb", min=0.01, help="Largest events.jsonl the browser may fill per session, in MiB")] = 5.0,
+    header_timeout: Annotated[float, typer.Option("--header-timeout", min=0.5, help="Seconds a new or idle connection has to send a whole request head before it is closed")] = 10.0,
+    body_timeout: Annotated[float, typer.Option("--body-timeout", min=0.5, help="Seconds a request body has to arrive (408 after)")] = 30.0,
+    max_connections_per_client: Annotated[int, typer.Option("--max-connections-per-client", min=1, help="Connections open at once from one client address (a browser uses up to 6)")] = 32,
+    max_connections: Annotated[int, typer.Option("--max-connections", min=8, help="Connections open at once in all; never more than the file-descriptor limit leaves after a reserve for the sessions")] = 1000,
 ) -> None:
     """Serve the study: participants give the preference or stop signal in the browser.
 
     Each session is saved like a simulated run (summary.json, rounds.jsonl, videos) in OUT/<session-id>/, plus events.jsonl with every UI event. The JSON API is described at /openapi.json.
     """
-    import uvicorn
     from rich.console import Console
 
     from activeintent.intentions.registry import IntentionError
     from activeintent.learners.registry import get_method
     from activeintent.runner import check_options
     from activeintent.suites import resolve as resolve_intention
+    from activeintent.web import transport
     from activeintent.web.limits import Limits
     from activeintent.web.server import create_app, runner_builder
     from activeintent.web.session import StudyConfig
@@ -108,7 +112,9 @@ def serve(
     config = next(iter(configs.values()))
     limits = Limits(max_sessions_per_client=max_sessions_per_client,
                     max_new_sessions_per_hour=max_new_sessions_per_hour, idle_timeout=idle_timeout * 60,
-                    max_body_bytes=max_request_kb * 1024, events_quota_bytes=int(events_quota_mb * 2**20))
+                    max_body_bytes=max_request_kb * 1024, events_quota_bytes=int(events_quota_mb * 2**20),
+                    header_timeout=header_timeout, body_timeout=body_timeout,
+                    max_connections_per_client=max_connections_per_client, max_connections=max_connections)
     if opt.check_only():
         return
     conditions = {name: (c, runner_builder(c, **extra)) for name, c in configs.items()} if study_file else None
@@ -131,7 +137,7 @@ def serve(
         console.print(f"Open http://{shown}:{port}/?pid=TEST — API schema at /openapi.json. Ctrl-C stops.")
         if host not in ("127.0.0.1", "localhost", "::1"):
             console.print(f"[yellow]Listening on {host}: anyone who can reach this address can take part.[/]")
-        uvicorn.run(app, host=host, port=port, log_level="warning")
+        transport.serve(app, host=host, port=port)
         return
     signal, rule = config.signal, config.intention
     method = config.method
@@ -147,7 +153,7 @@ def serve(
     console.print(f"Open http://{shown}:{port}/ — API schema at /openapi.json. Ctrl-C stops.")
     if host not in ("127.0.0.1", "localhost", "::1"):
         console.print(f"[yellow]Listening on {host}: anyone who can reach this address can take part.[/]")
-    uvicorn.run(app, host=host, port=port, log_level="warning")
+    transport.serve(app, host=host, port=port)
 
 
 def study_export(

@@ -12,7 +12,11 @@ representable as JSON (NaN, broken UTF-8).
 
 from __future__ import annotations
 
+import errno
 import logging
+import time
+from collections import Counter
+from collections.abc import Callable
 from typing import Any
 
 from fastapi import FastAPI, Request
@@ -36,7 +40,36 @@ DEFAULT_CODES = {
     429: "too_many_requests",
     500: "internal_error",
     503: "unavailable",
+    408: "request_timeout",
 }
+
+
+class RateLimitedLog:
+    """At most one line per ``every`` seconds of each kind, the next one saying how many were
+    left out: what a flood of bad connections makes the server say stays a few lines."""
+
+    def __init__(self, logger: logging.Logger, every: float = 10.0, clock: Callable[[], float] = time.monotonic):
+        self.logger, self.every, self.clock = logger, every, clock
+        self._last: dict[str, float] = {}
+        self._skipped: Counter[str] = Counter()
+
+    def warning(self, kind: str, message: str, *args: Any) -> bool:
+        """Log ``message % args`` unless a line of ``kind`` was logged less than ``every`` s ago."""
+        now = self.clock()
+        last = self._last.get(kind)
+        if last is not None and now - last < self.every:
+            self._skipped[kind] += 1
+            return False
+        skipped = self._skipped.pop(kind, 0)
+        if skipped:
+            message += " (and %d more like it in the last %.0f s)"
+            args = (*args, skipped, now - last)
+        self._last[kind] = now
+        self.logger.warning(message, *args)
+        return True
+
+
+_limited = RateLimitedLog(log)
 
 
 class ApiError(Exception):
@@ -94,5 +127,10 @@ def install_error_handlers(app: FastAPI) -> None:
 
     @app.exception_handler(Exception)
     async def _bug(request: Request, exc: Exception):
+        if isinstance(exc, OSError) and exc.errno in (errno.EMFILE, errno.ENFILE):
+            # not a bug: the process is out of file descriptors for now; one line, no traceback each
+            _limited.warning("fds", "out of file descriptors on %s %s: answered 503", request.method, request.url.path)
+            return error_response(503, "server_busy", "the server is out of resources for the moment; "
+                                  "try again in a few seconds", headers={"Retry-After": "5"})
         log.exception("unhandled error on %s %s", request.method, request.url.path)
         return error_response(500, "internal_error", "the server failed on this request; it is logged")

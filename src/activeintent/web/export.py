@@ -24,13 +24,13 @@ from activeintent.records import dumps
 
 SESSION_COLUMNS = [
     "session", "participant", "pid", "study_id", "prolific_session_id", "condition", "consented",
-    "button_order", "created", "ended", "status", "design", "intention", "intention_description",
+    "button_order", "key_id", "created", "ended", "status", "design", "intention", "intention_description",
     "method", "signal", "show_estimate", "video_size", "seed", "rounds_planned", "rounds_answered",
     "signals_used", "answers", "answer_seconds_total", "session_seconds", "success", "success_basis",
     "final_guess", "final_scene", "final_scene_index", "final_scene_feasible", "error", "questionnaire_final_attempt", "questionnaire_rule", "questionnaire_comments",
     "questionnaire_submitted",
 ]
-ROUND_COLUMNS = ["participant", "answer", "stop_time", "viewing", "after_end_presses", "response_s", "counted", "guess"]
+ROUND_COLUMNS = ["participant", "key", "answer", "stop_time", "viewing", "after_end_presses", "response_s", "counted", "guess"]
 FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
 
 
@@ -101,6 +101,7 @@ def session_record(folder: Path) -> dict:
     presented = {e.get("round"): e.get("server_ts") for e in server if e.get("type") == "round_presented"}
     answered_at = {e.get("round"): e.get("server_ts") for e in server if e.get("type") == "answer"}
     viewing = {e.get("round"): (e.get("client") or {}).get("viewing") for e in server if e.get("type") == "answer"}
+    answered_by = {e.get("round"): e.get("answered_by") for e in server if e.get("type") == "answer"}
     # presses of Stop once the video had ended: refused by the page, or by the server
     late: dict = {}
     for e in events:
@@ -115,9 +116,13 @@ def session_record(folder: Path) -> dict:
         t0, t1 = presented.get(n), answered_at.get(n)
         response = round(t1 - t0, 3) if isinstance(t0, int | float) and isinstance(t1, int | float) else None
         label = answer_label(h)
+        # who gave the answer, as the server saw it (sessions before the key cookie: unknown)
+        by = r.get("answered_by") or answered_by.get(n)
+        by = by if isinstance(by, dict) else {}
         rounds.append({
             "round": n,
-            "participant": participant,  # on every row, so a round table stands on its own
+            "participant": by.get("participant", participant),  # on every row: a round table stands on its own
+            "key": by.get("key"),
             "answer": label,
             "stop_time": h.get("stop_time"),
             # a stop in the first viewing or in a replay after it (older sessions: first)
@@ -141,6 +146,7 @@ def session_record(folder: Path) -> dict:
         "condition": info.get("condition", "single"),
         "consented": _iso(info.get("consented")),
         "button_order": " ".join(info.get("button_order") or []) or None,
+        "key_id": info.get("key_id"),
         "created": _iso(created),
         "ended": _iso(ended),
         "status": _status(info, folder, server),

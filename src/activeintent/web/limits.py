@@ -1,8 +1,10 @@
 """What keeps one client from spoiling a study for the others.
 
-* :class:`BodyGuard` (ASGI middleware): refuses a body larger than ``max_body_bytes`` before
-  reading it (by its Content-Length) or as soon as a streamed body passes the limit (413), and
-  lets only strict JSON into the API: UTF-8, finite numbers, integers within ±2**53, no lone
+* :class:`BodyGuard` (ASGI middleware): refuses a request with both Content-Length and
+  Transfer-Encoding (400, ambiguous framing), refuses a body larger than ``max_body_bytes`` before
+  reading it (by its Content-Length) or as soon as a streamed body passes the limit (413; the
+  rest is drained, bounded, so that the client reads the 413 instead of a reset), gives a body
+  ``body_timeout`` s to arrive (408), and lets only strict JSON into the API: UTF-8, finite numbers, integers within ±2**53, no lone
   surrogates, no duplicate keys, nesting at most 32 deep (422; 415 for a non-JSON type).
 * :class:`SessionLimits`: admission of new sessions (at most ``max_sessions_per_client`` in
   progress per client address, ``max_new_sessions_per_hour`` started per client address per
@@ -10,11 +12,14 @@
   has asked about for ``idle_timeout`` seconds (so an abandoned tab frees its slot), and the
   quota on what clients may write into a session's ``events.jsonl``.
 
-Time comes from an injectable clock so that expiry can be tested without waiting.
+Time comes from an injectable clock so that expiry can be tested without waiting. What is
+bounded below the app (request heads, connections per address and in all) is in
+:mod:`activeintent.web.transport`.
 """
 
 from __future__ import annotations
 
+import asyncio
 import json
 import math
 import threading
@@ -48,6 +53,17 @@ class Limits(BaseModel):
         180.0, gt=0, description="seconds without a request about a session before it is cancelled"
     )
     max_body_bytes: int = Field(128 * 1024, ge=1024, description="largest request body")
+    drain_bytes: int = Field(
+        16 * 1024 * 1024, ge=0, description="most of a refused body read (and dropped) so that its "
+        "sender can read the refusal; a larger body's sender may see the connection reset instead")
+    body_timeout: float = Field(
+        30.0, gt=0, description="seconds for a request body to arrive (and for draining a refused one)")
+    header_timeout: float = Field(
+        10.0, gt=0, description="seconds for a request head to arrive on a new or idle connection")
+    max_connections_per_client: int = Field(32, ge=1, description="connections open at once from one address")
+    max_connections: int = Field(
+        1000, ge=8, description="connections open at once in all (never more than the file-descriptor "
+        "limit leaves after a reserve for the sessions)")
     events_quota_bytes: int = Field(
         5 * 1024 * 1024, ge=1024, description="largest events.jsonl clients may fill in one session"
     )
@@ -145,42 +161,97 @@ def _json_type(content_type: str | None) -> bool:
 
 
 class BodyGuard:
-    """ASGI middleware: the body size limit for every request and strict JSON for the API's."""
+    """ASGI middleware: the body size limit for every request and strict JSON for the API's.
 
-    def __init__(self, app: ASGIApp, max_body_bytes: int, json_prefix: str = "/api/"):
+    A body over the limit is answered at once (413), from its Content-Length when it declares
+    one; the rest of it is then read and dropped, at most ``drain_bytes`` in all and for at most
+    ``drain_timeout`` s, before the answer ends and the connection closes. Closing a socket with
+    unread bytes in it resets the connection, and a client that sends its whole body before
+    reading (most do) would get that reset instead of its 413."""
+
+    def __init__(self, app: ASGIApp, max_body_bytes: int, json_prefix: str = "/api/",
+                 drain_bytes: int = 16 * 2**20, drain_timeout: float = 30.0):
+        # drain_timeout also bounds reading a body that is not refused (408 past it)
         self.app, self.max_body_bytes, self.json_prefix = app, max_body_bytes, json_prefix
+        self.drain_bytes, self.drain_timeout = drain_bytes, drain_timeout
 
     async def _refuse(self, scope: Scope, receive: Receive, send: Send, status: int, code: str, message: str,
                       close: bool = False) -> None:
         headers = {"Connection": "close"} if close else None
         await error_response(status, code, message, headers=headers)(scope, receive, send)
 
+    async def _refuse_unread(self, headers: Headers, receive: Receive, send: Send, status: int, code: str,
+                             message: str, read: int = 0) -> None:
+        """Refuse a request whose body is not (all) read yet: the whole answer first, then the
+        drain, then the end of the response, which closes the connection."""
+        response = error_response(status, code, message, headers={"Connection": "close"})
+        await send({"type": "http.response.start", "status": status, "headers": response.raw_headers})
+        # complete for the client (it has a Content-Length); the connection stays open meanwhile
+        await send({"type": "http.response.body", "body": response.body, "more_body": True})
+        declared = headers.get("content-length", "").strip()
+        fits = not declared.isdigit() or int(declared) <= self.drain_bytes
+        # a client that waits for "100 Continue" sends no body: there is nothing to drain
+        if fits and "100-continue" not in headers.get("expect", "").lower():
+            await self._drain(receive, read)
+        await send({"type": "http.response.body", "body": b"", "more_body": False})
+
+    async def _drain(self, receive: Receive, read: int) -> None:
+        try:
+            async with asyncio.timeout(self.drain_timeout):
+                while read <= self.drain_bytes:
+                    message = await receive()
+                    if message["type"] != "http.request":  # the client went away
+                        return
+                    read += len(message.get("body", b""))
+                    if not message.get("more_body", False):
+                        return
+        except TimeoutError:
+            return  # too slow: the connection closes with the rest unread
+
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
         headers = Headers(scope=scope)
+        if "transfer-encoding" in headers and "content-length" in headers:
+            # two framings: a proxy in front may have read the body by the other one (request
+            # smuggling), so neither is trusted
+            await self._refuse_unread(headers, receive, send, 400, "ambiguous_framing",
+                                      "the request has both Content-Length and Transfer-Encoding; send one")
+            return
         limit = self.max_body_bytes
         too_large = f"the request body is larger than {limit} bytes"
         declared = headers.get("content-length")
         if declared is not None and declared.strip().isdigit() and int(declared) > limit:
-            # refused from the header alone: not one byte of the body is read
-            await self._refuse(scope, receive, send, 413, "body_too_large", too_large, close=True)
+            # refused from the header alone, before any of the body is read
+            await self._refuse_unread(headers, receive, send, 413, "body_too_large", too_large)
             return
         chunks: list[bytes] = []
-        size = 0
-        while True:
-            message = await receive()
-            if message["type"] != "http.request":  # the client went away
-                return
-            chunk = message.get("body", b"")
-            size += len(chunk)
-            if size > limit:
+        size, more, over = 0, True, False
+        try:
+            # a body that trickles in holds a connection and a task: it has body_timeout s in all
+            async with asyncio.timeout(self.drain_timeout):
+                while more:
+                    message = await receive()
+                    if message["type"] != "http.request":  # the client went away
+                        return
+                    chunk = message.get("body", b"")
+                    size += len(chunk)
+                    more = message.get("more_body", False)
+                    if size > limit:
+                        over = True
+                        break
+                    chunks.append(chunk)
+        except TimeoutError:
+            await self._refuse(scope, receive, send, 408, "request_timeout",
+                               f"the request body did not arrive within {self.drain_timeout:g} s", close=True)
+            return
+        if over:
+            if more:
+                await self._refuse_unread(headers, receive, send, 413, "body_too_large", too_large, read=size)
+            else:
                 await self._refuse(scope, receive, send, 413, "body_too_large", too_large, close=True)
-                return
-            chunks.append(chunk)
-            if not message.get("more_body", False):
-                break
+            return
         body = b"".join(chunks)
         if body and scope["path"].startswith(self.json_prefix) and scope["method"] in ("POST", "PUT", "PATCH"):
             if not _json_type(headers.get("content-type")):

@@ -18,7 +18,7 @@ from contextlib import asynccontextmanager
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from fastapi import FastAPI, Request
+from fastapi import Depends, FastAPI, Request, Response
 from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import FileResponse
 from fastapi.staticfiles import StaticFiles
@@ -35,18 +35,37 @@ from activeintent.web.session import (
     SessionManager,
     StudyConfig,
     WebSession,
+    new_session_key,
 )
 from activeintent.web.study import PID_RULE, URL_PARAMETERS, StudyFile, check_pid
+from activeintent.web.transport import ConnectionGuard, RequestPhases
 
 STATIC = Path(__file__).parent / "static"
 MAX_FILE_NAME = 64  # longer than any video name the server writes
 log = logging.getLogger("activeintent.web")
 PAGES = {"/": "index.html", "/preference": "preference.html", "/clicker": "clicker.html", "/done": "done.html"}
+# The session key: set when a session starts, for that session's API paths only, never readable
+# by scripts, never sent by other sites' pages; every request that writes to the session needs it.
+KEY_COOKIE = "activeintent_key"
+KEY_COOKIE_MAX_AGE = 24 * 3600  # outlives any session and its questionnaire
+MAX_KEY_COOKIES = 8  # a request's cookies of that name that are looked at
+
+
+def key_cookies(request: Request) -> list[str]:
+    """The values of the request's session key cookies (a browser sends one per matching path)."""
+    values = []
+    for header in request.headers.getlist("cookie"):
+        for part in header.split(";"):
+            name, eq, value = part.strip().partition("=")
+            if eq and name == KEY_COOKIE:
+                values.append(value.strip().strip('"'))
+    return values[:MAX_KEY_COOKIES]
 
 
 # -- request bodies ---------------------------------------------------------------------------
 # Every body forbids fields it does not know and bounds every number: a typo or a probe is a
-# 422, never something silently ignored or stored.
+# 422, never something silently ignored or stored. Types are strict: true is not 1, "yes" is not
+# true and 1.0 is not round 1 (pydantic would convert each); a whole number still counts as seconds.
 MAX_ROUND = 10_000
 
 
@@ -55,7 +74,7 @@ def _client_ts():
 
 
 class _Body(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", strict=True)
 
 
 def _url_id(what: str):
@@ -172,6 +191,28 @@ class QuestionnaireAnswers(_Body):
 
 
 # -- the app ----------------------------------------------------------------------------------
+def own_session(sid: str, request: Request) -> WebSession:
+    """The session, for a request from the browser that started it. A dependency, so it is
+    checked before the body is validated: a stranger learns nothing from a session's answers."""
+    session = request.app.state.manager.get(sid)
+    if session is None:
+        raise ApiError(404, "unknown_session", f"unknown session {sid[:40]!r}")
+    if not session.holds_key(key_cookies(request)):
+        raise ApiError(403, "not_session_owner",
+                       f"session {sid} takes answers only from the browser that started it: this request has "
+                       f"no valid session key (the {KEY_COOKIE} cookie set when the session started); answer "
+                       "from the page the session was started on")
+    request.app.state.limits.touch(sid)  # only its own page keeps a session from going idle
+    return session
+
+
+Owned = Annotated[WebSession, Depends(own_session)]
+
+
+def answerer(session: WebSession, request: Request) -> dict:
+    return session.answered_by(request.client.host if request.client else None)
+
+
 def _feedback_maker(session: WebSession, body: PreferenceAnswer | StopAnswer):
     if body.kind != session.config.signal:
         raise AnswerRejected(
@@ -254,7 +295,14 @@ def create_app(
     app.state.manager = manager
     app.state.limits = guard
     install_error_handlers(app)
-    app.add_middleware(BodyGuard, max_body_bytes=limits.max_body_bytes)
+    app.add_middleware(BodyGuard, max_body_bytes=limits.max_body_bytes, drain_bytes=limits.drain_bytes,
+                       drain_timeout=limits.body_timeout)
+    # outermost: a request's connection learns when its head is complete (see web/transport.py)
+    connections = ConnectionGuard(header_timeout=limits.header_timeout,
+                                  max_connections_per_client=limits.max_connections_per_client,
+                                  max_connections=limits.max_connections)
+    app.state.connections = connections
+    app.add_middleware(RequestPhases, guard=connections)
 
     def session_or_404(sid: str) -> WebSession:
         session = manager.get(sid)
@@ -262,6 +310,7 @@ def create_app(
             raise ApiError(404, "unknown_session", f"unknown session {sid[:40]!r}")
         guard.touch(sid)  # somebody still cares about it: not idle
         return session
+
 
     @app.get("/api/config", summary="The study's configuration (what every session runs)")
     def get_config() -> dict:
@@ -290,12 +339,15 @@ def create_app(
         }
 
     @app.post("/api/sessions", status_code=201, summary="Start a session (its episode starts at once)")
-    def create_session(request: Request, body: NewSession | None = None) -> dict:
+    def create_session(request: Request, response: Response, body: NewSession | None = None) -> dict:
         body = body or NewSession()
         client = request.client.host if request.client else "unknown"
+        key, key_sha256 = new_session_key()
         session = guard.create(client, participant=body.participant, seed=body.seed, pid=body.pid,
                                study_id=body.study_id, prolific_session_id=body.prolific_session_id,
-                               consent=body.consent)
+                               consent=body.consent, key_sha256=key_sha256)
+        response.set_cookie(KEY_COOKIE, key, max_age=KEY_COOKIE_MAX_AGE, path=f"/api/sessions/{session.id}",
+                            httponly=True, samesite="strict", secure=request.url.scheme == "https")
         return session.state()
 
     @app.get("/api/sessions/{sid}", summary="Session state: round i of K, the question, z, status")
@@ -303,21 +355,18 @@ def create_app(
         return session_or_404(sid).state()
 
     @app.post("/api/sessions/{sid}/answer", summary="Answer the waiting round (names the round)")
-    def post_answer(sid: str, body: Answer) -> dict:
-        session = session_or_404(sid)
+    def post_answer(session: Owned, request: Request, body: Answer) -> dict:
         client = {"client_ts": body.client_ts,
                   **({"time": body.time, "viewing": body.viewing} if isinstance(body, StopAnswer) else {})}
-        h = session.answer(body.round, _feedback_maker(session, body), client=client)
+        h = session.answer(body.round, _feedback_maker(session, body), client=client, by=answerer(session, request))
         return {"accepted": True, "round": body.round, "answer": h.model_dump(mode="json")}
 
     @app.post("/api/sessions/{sid}/video", summary="The round's video: ready, ended or a replay starts")
-    def post_video(sid: str, body: VideoReport) -> dict:
-        session = session_or_404(sid)
+    def post_video(session: Owned, body: VideoReport) -> dict:
         return {"round": body.round, "viewing": session.video_event(body.round, body.event, body.media_time)}
 
     @app.post("/api/sessions/{sid}/events", summary="Append raw UI events (client timestamps kept)")
-    def post_events(sid: str, body: EventBatch) -> dict:
-        session = session_or_404(sid)
+    def post_events(session: Owned, body: EventBatch) -> dict:
         events = [e.model_dump() for e in body.events]
         with guard.events_quota(session, event_lines_size(events)):
             n = session.log_events(events)
@@ -325,9 +374,8 @@ def create_app(
 
     @app.post("/api/sessions/{sid}/questionnaire", status_code=201,
               summary="The end-of-session questionnaire (once, after the final attempt)")
-    def post_questionnaire(sid: str, body: QuestionnaireAnswers) -> dict:
-        session = session_or_404(sid)
-        record = session.submit_questionnaire(body.model_dump())
+    def post_questionnaire(session: Owned, request: Request, body: QuestionnaireAnswers) -> dict:
+        record = session.submit_questionnaire(body.model_dump(), by=answerer(session, request))
         return {"saved": True, "questionnaire": record}
 
     @app.get("/api/sessions/{sid}/result", summary="The episode's result (summary.json) once finished")

@@ -20,19 +20,22 @@ Two study designs:
 
 from __future__ import annotations
 
+import hashlib
+import hmac
 import json
 import re
 import secrets
 import threading
 import time
 import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import BaseModel, Field, computed_field, model_validator
 
-from activeintent.records import EpisodeRecorder
+from activeintent.protocol import FORMAT_VERSION
+from activeintent.records import EpisodeRecorder, dumps
 from activeintent.users.human import (
     AnswerRejected,
     HumanUser,
@@ -45,6 +48,7 @@ from activeintent.web.basics import EstimateMode, write_json
 from activeintent.web.errors import ApiError
 
 SESSION_ID = re.compile(r"^[0-9a-f]{16}$")
+KEY_ID_CHARS = 16  # of the key's SHA-256: enough to tell browsers apart, useless to forge one
 # Only these files are ever served from a session folder.
 SERVED_FILE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*\.(webm|gif)$")
 
@@ -118,6 +122,16 @@ EXPECTED_SUCCESS_BASIS = ("the learner's expected probability that this attempt 
                           "(its belief over rules, on this table)")
 
 
+def new_session_key() -> tuple[str, str]:
+    """A session key (the cookie's value, 256 random bits) and its SHA-256 (what is kept)."""
+    key = secrets.token_urlsafe(32)
+    return key, key_digest(key)
+
+
+def key_digest(key: str) -> str:
+    return hashlib.sha256(key.encode("utf-8", "surrogatepass")).hexdigest()
+
+
 class Enrolment(BaseModel):
     """How a session came to be: its condition (study file) and who it is, from the URL."""
 
@@ -130,6 +144,8 @@ class Enrolment(BaseModel):
     prolific_session_id: str | None = Field(None, description="SESSION_ID from the URL")
     consented: float | None = Field(None, description="server time the consent was given (None: no consent asked)")
     button_order: list[str] = Field(default_factory=list, description="the answer buttons, in the order shown")
+    key_id: str | None = Field(None, description="the start of the SHA-256 of the session key cookie given to "
+                               "the browser that started the session (the only one that may answer)")
 
 
 class Completion(BaseModel):
@@ -223,10 +239,17 @@ class StudyRecorder(EpisodeRecorder):
     """The episode's own writer, except that ``summary.json`` is written as the study reads
     it (:func:`study_summary`): a free-rule session's file never holds a score."""
 
-    def __init__(self, out: Path, config: StudyConfig):
+    def __init__(self, out: Path, config: StudyConfig, answered_by: Callable[[int], dict | None] | None = None):
         super().__init__(out)
         self.config = config
+        self.answered_by = answered_by or (lambda round: None)
         self.summary: dict | None = None
+
+    def answered(self, log) -> None:
+        # as the episode's own line, plus who gave the answer (participant, key, address)
+        line = {"format": FORMAT_VERSION, **log.model_dump(mode="json"), "answered_by": self.answered_by(log.round)}
+        with (self.out / "rounds.jsonl").open("a") as f:
+            f.write(dumps(line) + "\n")
 
     def finished(self, result) -> None:
         self.summary = study_summary(result.model_dump(mode="json"), self.config)
@@ -235,10 +258,14 @@ class StudyRecorder(EpisodeRecorder):
 
 class WebSession:
     def __init__(self, sid: str, seed: int, config: StudyConfig, builder: EpisodeBuilder, participant: str | None,
-                 enrolment: Enrolment | None = None, completion: Completion | None = None):
+                 enrolment: Enrolment | None = None, completion: Completion | None = None,
+                 key_sha256: str | None = None):
         self.id, self.seed, self.config, self.builder = sid, seed, config, builder
         self.participant = participant
         self.enrolment = enrolment or Enrolment()
+        # the SHA-256 of the session key cookie (never the key itself); None: nobody may answer
+        self._key_sha256 = key_sha256
+        self._answered_by: dict[int, dict] = {}  # round -> who gave its accepted answer
         self.completion = completion
         # per round: when the first viewing was started (Ready) and ended, and replays after it
         self._viewing: dict[int, dict] = {}
@@ -300,7 +327,7 @@ class WebSession:
     def _run(self) -> None:
         episode = None
         try:
-            recorder = StudyRecorder(self.dir, self.config)
+            recorder = StudyRecorder(self.dir, self.config, answered_by=self._answered_by.get)
             episode = self.builder(self.seed, self.dir, self.user, [recorder, self])
             result = episode.run()
             if self._final_trajectory is not None:
@@ -416,18 +443,38 @@ class WebSession:
         return self.rounds[-1].signals_used if self.rounds else 0
 
     # -- the person's side (request threads) -----------------------------------------------
-    def answer(self, round: int, make: Callable[[Question], Any], client: dict | None = None):
+    def holds_key(self, keys: Iterable[str]) -> bool:
+        """Whether one of ``keys`` (the request's key cookies) is this session's key."""
+        if self._key_sha256 is None:
+            return False
+        return any(hmac.compare_digest(key_digest(k), self._key_sha256) for k in keys)
+
+    def answered_by(self, address: str | None) -> dict:
+        """Who gives an answer now: the session's participant (the link's pid or the typed
+        code), the key they proved (its id) and the address the request came from."""
+        return {"participant": self.participant, "key": self.enrolment.key_id, "address": address}
+
+    def answer(self, round: int, make: Callable[[Question], Any], client: dict | None = None,
+               by: dict | None = None):
         if not self.active:
             raise AnswerRejected(f"session {self.id} is {self.status}; it takes no more answers", status=409)
+
+        def made(q: Question):
+            h = make(q)
+            # under the user's lock, so only the answer that is taken records who gave it (the
+            # episode may write the round before this call returns)
+            self._answered_by[q.round] = by
+            return h
+
         try:
-            h = self.user.answer(round, make)
+            h = self.user.answer(round, made)
         except ApiError as err:
             # a stop after the video's end is kept on record, as refused (other bad answers
             # change nothing saved)
             if err.code == "after_video_end":
-                self.log_server("stop_after_end", round=round, reason=err.message, client=client)
+                self.log_server("stop_after_end", round=round, reason=err.message, client=client, answered_by=by)
             raise
-        self.log_server("answer", round=round, answer=h.model_dump(mode="json"), client=client)
+        self.log_server("answer", round=round, answer=h.model_dump(mode="json"), client=client, answered_by=by)
         return h
 
     # -- what the participant did with the round's video (request threads) --------------------
@@ -512,7 +559,7 @@ class WebSession:
         }
 
     # -- the end-of-session questionnaire (request threads) ------------------------------------
-    def submit_questionnaire(self, answers: dict) -> dict:
+    def submit_questionnaire(self, answers: dict, by: dict | None = None) -> dict:
         """Keep the participant's answers in ``questionnaire.json`` (once; after the episode)."""
         if self.active:
             raise ApiError(409, "conflict", f"session {self.id} is {self.status}: the questionnaire comes "
@@ -537,6 +584,7 @@ class WebSession:
                 "session_status": self.status,
                 "submitted": time.time(),
                 **answers,
+                "answered_by": by,
             }
             write_json(self.dir / "questionnaire.json", record)
             self.questionnaire = record
@@ -588,7 +636,9 @@ class SessionManager:
 
     def create(self, participant: str | None = None, seed: int | None = None, pid: str | None = None,
                study_id: str | None = None, prolific_session_id: str | None = None,
-               consent: bool | None = None) -> WebSession:
+               consent: bool | None = None, key_sha256: str | None = None) -> WebSession:
+        """A new session, started. ``key_sha256``: the SHA-256 of the key the browser that asked
+        for it was given (:func:`new_session_key`); only requests carrying that key may answer."""
         from activeintent.web.study import button_order
 
         study = self.study
@@ -615,11 +665,12 @@ class SessionManager:
             enrolment = Enrolment(
                 **got.model_dump(), pid=pid, study_id=study_id, prolific_session_id=prolific_session_id,
                 consented=time.time() if consent else None,
-                button_order=button_order(config.signal, got.slot, study.counterbalance_buttons if study else True))
+                button_order=button_order(config.signal, got.slot, study.counterbalance_buttons if study else True),
+                key_id=key_sha256[:KEY_ID_CHARS] if key_sha256 else None)
             completion = Completion(code=study.completion_code, redirect_url=study.redirect_url,
                                     redirect_after_s=study.redirect_after_s) if study else None
             session = WebSession(sid, seed, config, builder, participant if pid is None else pid,
-                                 enrolment=enrolment, completion=completion)
+                                 enrolment=enrolment, completion=completion, key_sha256=key_sha256)
             self._sessions[sid] = session
         session.start()
         return session
