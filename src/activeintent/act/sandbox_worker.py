@@ -10,8 +10,9 @@ The child, before running untrusted code: starts a new session (own process grou
 stdin/stdout/stderr at /dev/null, keeps only the result pipe (fd 3); if it runs as root (only
 possible without namespaces), chroots into an empty read-only directory and drops to
 ``nobody``; sets RLIMIT_CPU, RLIMIT_AS, RLIMIT_FSIZE = 0, RLIMIT_NOFILE = 4, RLIMIT_NPROC = 0
-and RLIMIT_CORE = 0; and last installs the seccomp filter of ``seccomp`` (no open, socket,
-fork, exec, kill, ptrace, file-system change, mount, namespace, IPC, limit raising).
+and RLIMIT_CORE = 0; and last installs the seccomp allow-list of ``seccomp`` (memory, writing
+to open descriptors, exiting, clocks and little else; everything else, new calls included, is
+refused).
 """
 
 from __future__ import annotations
