@@ -1,6 +1,7 @@
 """The hostile corpus (hostile_corpus.py): each program refused by the allow-list or contained
 — with the guard, without it (the OS layer alone), and for the programs that go for the OS,
-with only the namespaces and with only seccomp. Nothing may leak out in any of these runs."""
+with only the namespaces and with only seccomp. Nothing may leak out in any of these runs, no
+run may hold the sandbox longer than its deadline, and no program is ever sent twice."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ import pytest
 from act_helpers import (
     SECRET_NAME,
     SECRET_VALUE,
+    TEST_LIMITS,
     assert_clean_text,
     assert_no_connection,
     assert_no_datagram,
@@ -22,7 +24,7 @@ from act_helpers import (
 from hostile_corpus import CONTAINED, CORPUS, HARMLESS, REFUSED, SYSCALL_ALLOWED
 
 from activeintent.act.cap import CapExecutor
-from activeintent.act.sandbox import SandboxResult
+from activeintent.act.sandbox import ACK_TIMEOUT_S, REPLY_GRACE_S, SandboxResult
 from activeintent.llm.scripted import ScriptedModel
 
 CONTAINED_KINDS = {"cpu", "wall", "memory", "runtime", "output", "crash"}
@@ -30,6 +32,9 @@ ALL_KINDS = CONTAINED_KINDS | {"refused", "sandbox", None}
 IDS = [h.name for h in CORPUS]
 OS_PROGRAMS = [h for h in CORPUS if "os" in h.tags]
 VICTIM_TEXT = "precious"
+# The longest a run may take once the worker is up: taking the request, the wall-time limit and
+# the parent's grace for the reply (a stopped worker used to hold the sandbox for 15 s).
+MAX_RUN_S = ACK_TIMEOUT_S + TEST_LIMITS.wall_seconds + REPLY_GRACE_S + 1.0
 
 
 def _xattrs(path: Path) -> list[str]:
@@ -135,10 +140,16 @@ def test_guarded(hostile, sandbox, state, scene):
 
 
 def _run(sandbox, hostile, state, scene, seccomp: bool) -> SandboxResult:
-    """One run, checked for what every mode must guarantee; with seccomp, also that no probed
-    system call got past the filter."""
-    result = sandbox.run(scene.fill(hostile.program), state)
+    """One run, checked for what every mode must guarantee: sent to a worker once, within the
+    deadline, and (with seccomp) no probed system call got past the filter."""
+    sends = []
+    real = sandbox._ensure_started
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(sandbox, "_ensure_started", lambda: (sends.append(1), real())[1])
+        result = sandbox.run(scene.fill(hostile.program), state)
     scene.assert_untouched(result)
+    assert len(sends) == 1, f"the program was sent {len(sends)} times: {result.error}"
+    assert result.elapsed_s <= MAX_RUN_S, f"the run held the sandbox {result.elapsed_s:.1f} s: {result.error}"
     if seccomp and "seccomp" in hostile.tags:
         assert SYSCALL_ALLOWED not in result.said, result.said
     return result
