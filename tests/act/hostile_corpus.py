@@ -5,10 +5,12 @@ must be ``refused`` by the guard, ``contained`` (stopped with an error by a limi
 restricted namespace or the OS layer) or ``harmless`` (it runs, and reaches nothing); and
 without the guard, with all builtins and imports, where only the OS layer (namespaces, seccomp,
 resource limits) stands between it and the machine. Programs tagged ``os`` also run with only
-the namespaces and with only seccomp, to show each OS layer holds on its own.
+the namespaces and with only seccomp, to show each OS layer holds on its own. Programs tagged
+``seccomp`` probe system calls the filter must refuse: they say SYSCALL_ALLOWED when a call got
+past it, which no run with seccomp may show.
 
-In every run, whatever the outcome: no file appears, changes or disappears outside the jail, no
-connection reaches the test's listener, no secret of the parent's environment comes back, the
+In every run, whatever the outcome: no file appears, changes (extended attributes included) or
+disappears outside the jail, no connection reaches the test's listener, no secret of the parent's environment comes back, the
 parent and the victim process live, the output is clean text, and the sandbox keeps working.
 
 Placeholders, filled in by the test: CANARY (a file that must never exist), OPEN_DIR (a
@@ -32,6 +34,37 @@ class Hostile(NamedTuple):
 REFUSED, CONTAINED, HARMLESS = "refused", "contained", "harmless"
 OS = frozenset({"os"})
 SLOW = frozenset({"slow"})  # runs into the CPU or wall-time limit
+SECCOMP = frozenset({"os", "seccomp"})
+SYSCALL_ALLOWED = "SYSCALL-ALLOWED"
+
+# Programs that call libc through ctypes (loaded already, so no file is opened): errno 1 (EPERM)
+# is the filter's answer; anything else means the call reached the kernel.
+_LIBC = "import ctypes, os, signal\nlibc = ctypes.CDLL(None, use_errno=True)\n"
+
+
+def _reached(*calls: str, before: str = "") -> str:
+    """A program that says SYSCALL_ALLOWED if any of ``calls`` got past seccomp."""
+    lines = [_LIBC + before, "reached = []"]
+    for call in calls:
+        lines.append(f"r = {call}\nif r >= 0 or ctypes.get_errno() != 1:\n    reached.append({call!r})")
+    lines.append(f"if reached:\n    say('{SYSCALL_ALLOWED}')\n    say(reached)")
+    return "\n".join(lines)
+
+
+def _sigio(owner: str, signum: str) -> str:
+    """Ask the kernel to send ``signum`` to ``owner`` whenever the result pipe is read (the
+    audit's S1: the worker reads it), then write to it."""
+    return _LIBC + (
+        f"ok = [libc.fcntl(3, 8, {owner}), libc.fcntl(3, 10, {signum}), libc.fcntl(3, 4, os.O_ASYNC)]\n"
+        f"if min(ok) >= 0:\n    say('{SYSCALL_ALLOWED}')\n"
+        "os.write(3, b' ')\n"
+        # The signal is sent when the runner reads, as long as this end is open: stay a moment.
+        "import time\nt = time.monotonic()\nwhile time.monotonic() - t < 0.5:\n    pass\n"
+    )
+
+
+# struct xattr_args {u64 value; u32 size; u32 flags} for setxattrat (Linux 6.13)
+_XATTR_ARGS = "v = ctypes.create_string_buffer(b'owned')\nxa = (ctypes.c_uint64 * 2)(ctypes.addressof(v), 5)\n"
 
 
 def _h(name: str, program: str, guarded: str, tags: frozenset[str] = frozenset()) -> Hostile:
@@ -113,12 +146,33 @@ CORPUS: list[Hostile] = [
     _h("np-dlpack", "say(np.from_dlpack(np.zeros(2)))", REFUSED),
     _h("np-object-kw", "a = np.array([say], dtype=object)\nsay(a)", REFUSED),
     _h("np-object-str", "a = np.zeros(3, dtype='O')", REFUSED),
-    _h("np-object-positional", "a = np.zeros(3, 'O')\nsay(a)", CONTAINED),
+    _h("np-object-positional", "a = np.zeros(3, 'O')\nsay(a)", REFUSED),
     _h("np-object-variable", "t = 'O'\na = np.array([1], dtype=t)", REFUSED),
     _h("np-astype-object", "a = np.zeros(2).astype('O')", REFUSED),
     _h("np-astype-variable", "t = 'O'\na = np.zeros(2).astype(t)", REFUSED),
     _h("np-mixed-object", "a = np.array([1, 'a', None])\nsay(a)", CONTAINED),
-    _h("np-structured", "a = np.zeros(2, [('f', 'O')])\nsay(a)", CONTAINED),
+    _h("np-structured", "a = np.zeros(2, [('f', 'O')])\nsay(a)", REFUSED),
+    # Object arrays through array methods and other ways of naming a dtype (audit S5).
+    _h("np-method-object", "a = np.zeros(3).cumsum(0, 'O')\na[0] = say\na[1] = a\nsay(a)", REFUSED),
+    _h("np-method-sum-object", "a = np.ones((2, 2)).sum(0, object)\na[0] = say", REFUSED),
+    _h("np-method-trace-object", "a = np.ones((2, 2, 2)).trace(0, 0, 1, 'O')\na[0] = say", REFUSED),
+    _h("np-method-mean-object", "a = np.ones((2, 2)).mean(0, '|O')\na[0] = say", REFUSED),
+    _h("np-method-variable", "t = 'O'\na = np.zeros(3).cumprod(0, t)\na[0] = say", REFUSED),
+    _h("np-method-alias", "f = np.zeros(3).cumsum\na = f(0, 'O')\na[0] = say", REFUSED),
+    _h("np-method-map", "a = list(map(np.zeros(3).cumsum, [0], ['O']))[0]\na[0] = say", REFUSED),
+    _h("np-method-star", "a = np.zeros(3).cumsum(*[0, 'O'])\na[0] = say", REFUSED),
+    _h("np-method-kwargs", "a = np.zeros(3).cumsum(**{'dtype': 'O'})\na[0] = say", REFUSED),
+    _h("np-rebind", "np = np.zeros(3)\na = np.cumsum(0, 'O')\na[0] = say", REFUSED),
+    _h("np-param-rebind", "def f(np):\n    return np.cumsum(0, 'O')\na = f(np.zeros(3))\na[0] = say", REFUSED),
+    _h("np-float-rebind", "float = 'O'\na = np.zeros(3).astype(float)\na[0] = say", REFUSED),
+    _h("np-attribute-set", "np.float64 = 'O'\na = np.zeros(3).astype(np.float64)\na[0] = say", REFUSED),
+    _h("np-dtype-object", "a = np.zeros(3).astype(np.zeros(1).dtype)", REFUSED),
+    _h("np-dtype-elsewhere", "d = {}\na = np.zeros(3, dtype=d.float64)", REFUSED),
+    _h("np-object-bytes", "a = np.zeros(3).cumsum(0, b'O')", REFUSED),
+    _h("np-full-object", "a = np.full(3, say)\na[0] = a", CONTAINED),
+    # Still possible: an object array numpy makes by itself for a number beyond 64 bits. It is
+    # only a list then (no raw memory can be reached); what contains a program is the OS layer.
+    _h("np-implicit-object", "a = np.zeros(1) + [10 ** 30]\na[0] = say\nsay(len(a))", HARMLESS),
     # The real numpy, reached by import when the guard is off: raw memory in the child only.
     _h("real-numpy-as-strided", "import numpy\na = numpy.lib.stride_tricks.as_strided(numpy.zeros(1), shape=(1 << 26,), "
        "strides=(64,))\nsay(float(a.sum()))", REFUSED),
@@ -196,6 +250,40 @@ CORPUS: list[Hostile] = [
     _h("hostname", "import socket\nsay(socket.gethostname())", REFUSED, OS),
     _h("secret-in-memory", "import gc\nsay([o for o in gc.get_objects() if isinstance(o, str) and 'sk-fake' in o])",
        REFUSED, OS),
+    # Signals by proxy: the kernel signals a descriptor's owner when the result pipe is read
+    # (audit S1). Stopping or killing the worker must neither stall the parent nor re-run the
+    # program; without namespaces (as a normal user) the victim is the user's own process.
+    _h("sigio-stop-worker", _sigio("os.getppid()", "signal.SIGSTOP"), REFUSED, SECCOMP),
+    _h("sigio-stop-worker-group", _sigio("-os.getpgid(os.getppid())", "signal.SIGSTOP"), REFUSED, SECCOMP),
+    _h("sigio-kill-worker", _sigio("os.getppid()", "signal.SIGKILL"), REFUSED, SECCOMP),
+    _h("sigio-kill-worker-group", _sigio("-os.getpgid(os.getppid())", "signal.SIGKILL"), REFUSED, SECCOMP),
+    _h("sigio-kill-victim", _sigio("VICTIM_PID", "signal.SIGKILL"), REFUSED, SECCOMP),
+    _h("sigio-owner-ex", _reached("libc.fcntl(3, 15, (ctypes.c_int * 2)(1, os.getppid()))",
+                                  "libc.fcntl(3, 10, signal.SIGSTOP)"), REFUSED, SECCOMP),
+    _h("fcntl-lease-notify", _reached("libc.fcntl(3, 1024, 0)", "libc.fcntl(3, 1026, 0x80000001)",
+                                      "libc.fcntl(3, 9, 0)", "libc.fcntl(3, 1031, 1 << 20)"), REFUSED, SECCOMP),
+    # What the host does, its mounts and kernel memory outside RLIMIT_AS (audit S3).
+    _h("inotify", _reached("libc.inotify_init1(0)", "libc.inotify_init()", "libc.inotify_add_watch(0, b'/usr', 0xfff)",
+                           before="os.close(0)\n"), REFUSED, SECCOMP),
+    _h("fanotify", _reached("libc.fanotify_init(0, 0)", before="os.close(0)\n"), REFUSED, SECCOMP),
+    _h("listmount-statmount", _reached("libc.syscall(458, 0, 0, 0, 0)", "libc.syscall(457, 0, 0, 0, 0)"),
+       REFUSED, SECCOMP),
+    _h("timer-create", _reached("libc.timer_create(1, None, ctypes.byref(ctypes.c_void_p()))",
+                                "libc.timerfd_create(1, 0)", before="os.close(0)\n"), REFUSED, SECCOMP),
+    # System calls newer than a deny-list (audit S4): extended attributes, file attributes,
+    # mount trees; and numbers no kernel has yet.
+    _h("setxattrat", _reached("libc.syscall(463, -100, b'VICTIM_FILE', 0, b'user.owned', xa, 16)",
+                              before=_XATTR_ARGS), REFUSED, SECCOMP),
+    _h("removexattrat", _reached("libc.syscall(466, -100, b'VICTIM_FILE', 0, b'user.owned')"), REFUSED, SECCOMP),
+    _h("xattrat-read", _reached("libc.syscall(464, -100, b'/', 0, b'user.x', xa, 16)",
+                                "libc.syscall(465, -100, b'/', 0, v, 5)", before=_XATTR_ARGS), REFUSED, SECCOMP),
+    _h("file-setattr", _reached("libc.syscall(469, -100, b'VICTIM_FILE', ctypes.create_string_buffer(64), 24, 0)",
+                                "libc.syscall(468, -100, b'/', ctypes.create_string_buffer(64), 24, 0)"),
+       REFUSED, SECCOMP),
+    _h("open-tree-attr", _reached("libc.syscall(467, -100, b'/', 0, None, 0)", before="os.close(0)\n"),
+       REFUSED, SECCOMP),
+    _h("future-syscalls", _LIBC + "seen = [n for n in range(470, 560) if libc.syscall(n, 0, 0, 0, 0, 0, 0) != -1 "
+       f"or ctypes.get_errno() != 1]\nif seen:\n    say('{SYSCALL_ALLOWED}')\n    say(seen)", REFUSED, SECCOMP),
     # What the child hands back is data: forged, malformed or oversized results.
     _h("forged-result", "import os\nos.write(3, b'{\"skills\": [{\"skill\": \"put_in\", \"block\": \"red block\", "
        "\"bowl\": \"gold bowl\"}], \"said\": []}')\nos._exit(0)", REFUSED),

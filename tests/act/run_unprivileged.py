@@ -23,7 +23,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 USER = os.environ.get("ACTIVEINTENT_TEST_USER", "activeintent-test")
 INNER = "--inside-private-mounts"
-KEPT_ENV = ("CI", "OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE", "LANG", "TERM")
+# PYTHONPATH: a work tree tested with another checkout's virtualenv points it at its own src.
+KEPT_ENV = ("CI", "OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE", "LANG", "TERM", "PYTHONPATH")
 
 
 def _ids(user: str) -> tuple[int, int] | None:

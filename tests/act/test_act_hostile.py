@@ -1,9 +1,11 @@
 """The hostile corpus (hostile_corpus.py): each program refused by the allow-list or contained
 — with the guard, without it (the OS layer alone), and for the programs that go for the OS,
-with only the namespaces and with only seccomp. Nothing may leak out in any of these runs."""
+with only the namespaces and with only seccomp. Nothing may leak out in any of these runs, no
+run may hold the sandbox longer than its deadline, and no program is ever sent twice."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import stat
 from collections import Counter
@@ -13,15 +15,16 @@ import pytest
 from act_helpers import (
     SECRET_NAME,
     SECRET_VALUE,
+    TEST_LIMITS,
     assert_clean_text,
     assert_no_connection,
     assert_no_datagram,
     process_state,
 )
-from hostile_corpus import CONTAINED, CORPUS, HARMLESS, REFUSED
+from hostile_corpus import CONTAINED, CORPUS, HARMLESS, REFUSED, SYSCALL_ALLOWED
 
 from activeintent.act.cap import CapExecutor
-from activeintent.act.sandbox import SandboxResult
+from activeintent.act.sandbox import ACK_TIMEOUT_S, REPLY_GRACE_S, SandboxResult
 from activeintent.llm.scripted import ScriptedModel
 
 CONTAINED_KINDS = {"cpu", "wall", "memory", "runtime", "output", "crash"}
@@ -29,6 +32,15 @@ ALL_KINDS = CONTAINED_KINDS | {"refused", "sandbox", None}
 IDS = [h.name for h in CORPUS]
 OS_PROGRAMS = [h for h in CORPUS if "os" in h.tags]
 VICTIM_TEXT = "precious"
+# The longest a run may take once the worker is up: taking the request, the wall-time limit and
+# the parent's grace for the reply (a stopped worker used to hold the sandbox for 15 s).
+MAX_RUN_S = ACK_TIMEOUT_S + TEST_LIMITS.wall_seconds + REPLY_GRACE_S + 1.0
+
+
+def _xattrs(path: Path) -> list[str]:
+    with contextlib.suppress(OSError):
+        return sorted(os.listxattr(path))
+    return []
 
 
 def test_corpus_size_and_outcomes():
@@ -57,6 +69,7 @@ class Scene:
         self.victim_file.write_text(VICTIM_TEXT)
         self.victim_file.chmod(0o666)
         self.victim_stat = self.victim_file.stat()
+        self.victim_xattrs = _xattrs(self.victim_file)
         self.listener, self.udp_listener, self.victim = listener, udp_listener, victim
         self.env_before, self.pid_before = _env(), os.getpid()
 
@@ -79,6 +92,7 @@ class Scene:
         now = self.victim_file.stat()
         assert self.victim_file.read_text() == VICTIM_TEXT
         assert stat.S_IMODE(now.st_mode) == 0o666 and now.st_mtime_ns == self.victim_stat.st_mtime_ns
+        assert _xattrs(self.victim_file) == self.victim_xattrs, "an extended attribute was set or removed"
         assert_no_connection(self.listener)
         assert_no_datagram(self.udp_listener)
         assert os.getpid() == self.pid_before and _env() == self.env_before
@@ -125,25 +139,38 @@ def test_guarded(hostile, sandbox, state, scene):
     _still_works(sandbox, state)
 
 
+def _run(sandbox, hostile, state, scene, seccomp: bool) -> SandboxResult:
+    """One run, checked for what every mode must guarantee: sent to a worker once, within the
+    deadline, and (with seccomp) no probed system call got past the filter."""
+    sends = []
+    real = sandbox._ensure_started
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(sandbox, "_ensure_started", lambda: (sends.append(1), real())[1])
+        result = sandbox.run(scene.fill(hostile.program), state)
+    scene.assert_untouched(result)
+    assert len(sends) == 1, f"the program was sent {len(sends)} times: {result.error}"
+    assert result.elapsed_s <= MAX_RUN_S, f"the run held the sandbox {result.elapsed_s:.1f} s: {result.error}"
+    if seccomp and "seccomp" in hostile.tags:
+        assert SYSCALL_ALLOWED not in result.said, result.said
+    return result
+
+
 @pytest.mark.parametrize("hostile", CORPUS, ids=IDS)
 def test_unguarded(hostile, unguarded_sandbox, state, scene):
     """Without the guard (all builtins, imports allowed): the OS layer contains every program."""
-    result = unguarded_sandbox.run(scene.fill(hostile.program), state)
-    scene.assert_untouched(result)
+    _run(unguarded_sandbox, hostile, state, scene, seccomp=True)
     _still_works(unguarded_sandbox, state)
 
 
 @pytest.mark.parametrize("hostile", OS_PROGRAMS, ids=[h.name for h in OS_PROGRAMS])
 def test_namespaces_alone(hostile, namespaces_only_sandbox, state, scene):
     """No guard, no seccomp: the namespaces (and limits) alone contain what goes for the OS."""
-    result = namespaces_only_sandbox.run(scene.fill(hostile.program), state)
-    scene.assert_untouched(result)
+    _run(namespaces_only_sandbox, hostile, state, scene, seccomp=False)
     _still_works(namespaces_only_sandbox, state)
 
 
 @pytest.mark.parametrize("hostile", OS_PROGRAMS, ids=[h.name for h in OS_PROGRAMS])
 def test_seccomp_alone(hostile, seccomp_only_sandbox, state, scene):
     """No guard, no namespaces (--unsafe-no-isolation): seccomp and limits alone contain it."""
-    result = seccomp_only_sandbox.run(scene.fill(hostile.program), state)
-    scene.assert_untouched(result)
+    _run(seccomp_only_sandbox, hostile, state, scene, seccomp=True)
     _still_works(seccomp_only_sandbox, state)

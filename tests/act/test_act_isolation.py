@@ -13,7 +13,7 @@ import textwrap
 from pathlib import Path
 
 import pytest
-from act_helpers import SECRET_VALUE, TEST_LIMITS, require_namespaces
+from act_helpers import SECRET_VALUE, TEST_LIMITS, descendants, require_namespaces
 
 from activeintent.act import isolation
 from activeintent.act.base import make_executor
@@ -37,24 +37,27 @@ def _facts(sandbox, program: str, state) -> dict:
     return json.loads(result.said[-1])
 
 
-def test_worker_runs_in_its_own_namespaces(unguarded_sandbox, state, tmp_path):
-    """Fails when the worker is started without bubblewrap (or with fewer namespaces)."""
-    facts = _facts(unguarded_sandbox, textwrap.dedent(f"""
+def test_worker_runs_in_its_own_namespaces(namespaces_only_sandbox, state, tmp_path):
+    """Fails when the worker is started without bubblewrap (or with fewer namespaces). Without
+    seccomp, whose allow-list would refuse stat and uname by itself."""
+    facts = _facts(namespaces_only_sandbox, textwrap.dedent(f"""
         import json, os, socket
+        os.close(0)  # room under the open-files limit to list /proc
         facts = {{
-            "ppid": os.getppid(), "uid": os.getuid(), "gid": os.getgid(), "host": socket.gethostname(),
+            "procs": [p for p in os.listdir("/proc") if p.isdigit()], "uid": os.getuid(), "gid": os.getgid(), "host": socket.gethostname(),
             "passwd": os.path.exists("/etc/passwd"), "home": os.path.exists("/home"),
             "tmp_path": os.path.exists({str(tmp_path)!r}), "parent": os.path.exists("/proc/{os.getpid()}"),
             "env": sorted(os.environ), "net": os.path.exists("/sys/class/net"),
         }}"""), state)
-    assert facts["ppid"] < 10, "no PID namespace: the worker has a host process id"
+    # bubblewrap's init, the template, the program's runner and the program itself
+    assert len(facts["procs"]) <= 5, f"no PID namespace: /proc lists {len(facts['procs'])} processes"
     assert facts["uid"] == facts["gid"] == 65534
     assert facts["host"] == "sandbox", "no UTS namespace"
     assert not facts["passwd"] and not facts["home"] and not facts["net"], "the host file system is visible"
     assert not facts["tmp_path"], "the test's folder is visible"
     assert not facts["parent"], "the parent's /proc entry is visible"
     assert set(facts["env"]) <= ALLOWED_ENV, facts["env"]
-    assert unguarded_sandbox.isolation == "bwrap" and unguarded_sandbox.workdir is None
+    assert namespaces_only_sandbox.isolation == "bwrap" and namespaces_only_sandbox.workdir is None
 
 
 def test_network_namespace_has_no_route_out(namespaces_only_sandbox, state, listener):
@@ -77,19 +80,26 @@ def test_network_namespace_has_no_route_out(namespaces_only_sandbox, state, list
 
 def test_seccomp_refuses_system_calls(unguarded_sandbox, state):
     """Fails when the seccomp filter is not installed: each call would then work or fail with
-    another error (read-only file system, no such file, network unreachable)."""
+    another error (read-only file system, no such file, network unreachable, and ENOSYS for a
+    number no kernel has yet)."""
     if platform.machine().lower() not in ("x86_64", "amd64", "aarch64", "arm64"):
         pytest.skip("no seccomp filter for this architecture")
     assert unguarded_sandbox.seccomp_active
     facts = _facts(unguarded_sandbox, textwrap.dedent("""
-        import errno, json, os, socket
+        import ctypes, errno, json, os, socket
+        libc = ctypes.CDLL(None, use_errno=True)
         def attempt(fn):
             try:
                 fn()
                 return "allowed"
             except OSError as e:
                 return errno.errorcode.get(e.errno, str(e.errno))
+        def call(*args):
+            if libc.syscall(*args) == -1:
+                raise OSError(ctypes.get_errno(), "")
         facts = {
+            "stat": attempt(lambda: os.stat("/")),
+            "future": attempt(lambda: call(600)),
             "socket": attempt(lambda: socket.socket()),
             "open": attempt(lambda: open("/usr/lib/os-release").close()),
             "mkdir": attempt(lambda: os.mkdir("/made")),
@@ -111,27 +121,10 @@ def test_resource_limits_in_the_child(unguarded_sandbox, state):
     assert facts["RLIMIT_NOFILE"] == [4, 4]
 
 
-def _descendants(pid: int) -> list[int]:
-    children: dict[int, list[int]] = {}
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                ppid = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
-            except (OSError, IndexError, ValueError):
-                continue
-            children.setdefault(ppid, []).append(int(entry.name))
-    out, todo = [], [pid]
-    while todo:
-        for child in children.get(todo.pop(), []):
-            out.append(child)
-            todo.append(child)
-    return out
-
-
 def test_sandbox_processes_are_not_root(sandbox):
     """Seen from the host: everything below bubblewrap runs as an unprivileged user, also when
     the tests run as root."""
-    inner = _descendants(sandbox.worker_pid)
+    inner = descendants(sandbox.worker_pid)
     assert inner, "no process below bubblewrap"
     for pid in inner:
         uids = [line for line in Path(f"/proc/{pid}/status").read_text().splitlines() if line.startswith("Uid:")]
@@ -160,10 +153,12 @@ def test_unsafe_mode_runs_with_seccomp_and_limits(state, monkeypatch):
 
 
 @pytest.mark.skipif(os.geteuid() != 0, reason="the chroot is only used when the tests run as root")
-def test_unsafe_mode_as_root_chroots_and_drops_to_nobody(seccomp_only_sandbox, state):
-    """Fails when the root child keeps its uid or the host file system."""
-    facts = _facts(seccomp_only_sandbox, "import json, os\nfacts = {'uid': os.getuid(), "
-                   "'passwd': os.path.exists('/etc/passwd'), 'root': os.path.exists('/usr')}", state)
+def test_unsafe_mode_as_root_chroots_and_drops_to_nobody(state):
+    """Fails when the root child keeps its uid or the host file system (seccomp off: its
+    allow-list would refuse stat by itself)."""
+    with Sandbox(TEST_LIMITS, isolation="none", unsafe_no_isolation=True, guard=False, seccomp=False) as sb:
+        facts = _facts(sb, "import json, os\nfacts = {'uid': os.getuid(), "
+                       "'passwd': os.path.exists('/etc/passwd'), 'root': os.path.exists('/usr')}", state)
     assert facts == {"uid": 65534, "passwd": False, "root": False}
 
 

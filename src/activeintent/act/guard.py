@@ -5,8 +5,11 @@ robot API provides. Everything that can reach the interpreter's internals is ref
 program runs: imports, every name or attribute starting with ``_``, introspection builtins,
 frame/generator/code attributes (which need no underscore), ``str.format`` (whose format
 strings can walk attributes), classes, ``global``/``nonlocal``, ``yield``, ``async`` (also
-asynchronous comprehensions) and ``with``; numpy's raw-memory and file attributes, and ``dtype``
-arguments other than plain numeric literals (no object or structured arrays).
+asynchronous comprehensions) and ``with``; numpy's raw-memory and file attributes; and every
+way of naming a dtype that is not a plain numeric literal (no object, void or structured
+arrays): ``dtype=`` keywords, the dtype argument given by position to ``np`` functions and to
+array methods (``a.cumsum(0, 'O')``, ``a.astype(t)``), ``*``/``**`` unpacking into such calls,
+such methods taken without being called (``f = a.cumsum``) and rebinding the name ``np``.
 
 A check of source text cannot close every hole: it is only the first layer. What contains a
 program is the worker's isolation (namespaces, seccomp, resource limits: see ``sandbox`` and
@@ -68,6 +71,17 @@ ALLOWED_DTYPE_STRINGS = frozenset({
     "uint32", "uint64", "float16", "float32", "float64", "complex64", "complex128", "i1", "i2",
     "i4", "i8", "u1", "u2", "u4", "u8", "f2", "f4", "f8", "c8", "c16", "b1", "?", "i", "f", "d",
 })
+# Where a dtype may be passed by position: ``np`` functions (receiver ``np``) and the array
+# methods of the same or other names. Index of the dtype among the positional arguments.
+NP_DTYPE_POSITIONS = {
+    "array": 1, "asarray": 1, "zeros": 1, "ones": 1, "full": 2, "zeros_like": 1, "ones_like": 1,
+    "arange": 3, "linspace": 5, "eye": 3, "sum": 2, "prod": 2, "cumsum": 2, "mean": 2, "std": 2, "var": 2,
+}
+METHOD_DTYPE_POSITIONS = {
+    "astype": 0, "sum": 1, "prod": 1, "cumsum": 1, "cumprod": 1, "mean": 1, "std": 1, "var": 1, "trace": 3,
+}
+# Names whose meaning the dtype checks rely on.
+PROTECTED_NAMES = frozenset({"np", *ALLOWED_DTYPE_NAMES})
 FORBIDDEN_ATTRIBUTE_PREFIXES = ("_", "gi_", "cr_", "ag_", "f_", "tb_", "co_", "func_", "im_")
 
 
@@ -80,7 +94,10 @@ def _where(node: ast.AST) -> str:
     return f" (line {line})" if line else ""
 
 
-def _check_name(name: str, node: ast.AST) -> None:
+def _check_name(name: str, node: ast.AST, binds: bool = False) -> None:
+    if binds and name in PROTECTED_NAMES:
+        # ``np.<name>`` must stay the restricted numpy, and a dtype written ``float`` a float.
+        raise GuardError(f"the name {name!r} cannot be rebound{_where(node)}")
     if name != "_" and name.startswith("_"):
         raise GuardError(f"names starting with '_' are not allowed: {name!r}{_where(node)}")
     if name in FORBIDDEN_NAMES:
@@ -95,10 +112,20 @@ def _check_attribute(attr: str, node: ast.AST) -> None:
         raise GuardError(f"attribute {attr!r} is not allowed{_where(node)}")
 
 
+def _is_np(node: ast.expr) -> bool:
+    return isinstance(node, ast.Name) and node.id == "np"
+
+
+def _rooted_at_np(node: ast.expr) -> bool:
+    while isinstance(node, (ast.Attribute, ast.Subscript)):
+        node = node.value
+    return _is_np(node)
+
+
 def _check_dtype(value: ast.expr, node: ast.AST) -> None:
     ok = (
         (isinstance(value, ast.Name) and value.id in ALLOWED_DTYPE_NAMES)
-        or (isinstance(value, ast.Attribute) and value.attr in ALLOWED_DTYPE_ATTRIBUTES)
+        or (isinstance(value, ast.Attribute) and _is_np(value.value) and value.attr in ALLOWED_DTYPE_ATTRIBUTES)
         or (isinstance(value, ast.Constant) and isinstance(value.value, str)
             and value.value.lstrip("<>=|") in ALLOWED_DTYPE_STRINGS)
         or (isinstance(value, ast.Constant) and value.value is None)
@@ -110,15 +137,37 @@ def _check_dtype(value: ast.expr, node: ast.AST) -> None:
         )
 
 
+def _dtype_position(func: ast.expr) -> int | None:
+    """Where ``func`` (the callee) takes a dtype by position, or None."""
+    if not isinstance(func, ast.Attribute):
+        return None
+    if _is_np(func.value):
+        return NP_DTYPE_POSITIONS.get(func.attr)
+    return METHOD_DTYPE_POSITIONS.get(func.attr)
+
+
 def _check_call(node: ast.Call) -> None:
     for kw in node.keywords:
         if kw.arg == "dtype":
             _check_dtype(kw.value, node)
-    if isinstance(node.func, ast.Attribute) and node.func.attr == "astype":
-        if not node.args and not any(kw.arg == "dtype" for kw in node.keywords):
-            raise GuardError(f"astype needs a dtype{_where(node)}")
-        for arg in node.args[:1]:
-            _check_dtype(arg, node)
+    position = _dtype_position(node.func)
+    if position is None:
+        return
+    name = node.func.attr  # type: ignore[attr-defined]
+    if any(isinstance(a, ast.Starred) for a in node.args) or any(kw.arg is None for kw in node.keywords):
+        raise GuardError(f"arguments of {name}() must be written out, without * or ** unpacking{_where(node)}")
+    if name == "astype" and not node.args and not any(kw.arg == "dtype" for kw in node.keywords):
+        raise GuardError(f"astype needs a dtype{_where(node)}")
+    if len(node.args) > position:
+        _check_dtype(node.args[position], node)
+
+
+def _check_method_reference(node: ast.Attribute, parent: ast.AST | None) -> None:
+    """An array method that takes a dtype must be called where it is named: held in a variable
+    or passed on, its dtype argument could no longer be checked."""
+    if node.attr in METHOD_DTYPE_POSITIONS and not _is_np(node.value):
+        if not (isinstance(parent, ast.Call) and parent.func is node):
+            raise GuardError(f"the method {node.attr!r} may only be called directly{_where(node)}")
 
 
 def check_program(source: str) -> ast.Module:
@@ -133,22 +182,28 @@ def check_program(source: str) -> ast.Module:
         raise GuardError(f"syntax error on line {e.lineno}: {e.msg}") from None
     except (ValueError, RecursionError, MemoryError) as e:  # null bytes, absurd nesting
         raise GuardError(f"program cannot be parsed: {type(e).__name__}") from None
+    parents: dict[ast.AST, ast.AST] = {}
     for node in ast.walk(tree):
+        for child in ast.iter_child_nodes(node):
+            parents[child] = node
         if not isinstance(node, ALLOWED_NODES):
             kind = type(node).__name__
             hint = " (no imports: the robot API and np are already available)" if "Import" in kind else ""
             raise GuardError(f"{kind} statements/expressions are not allowed{hint}{_where(node)}")
         if isinstance(node, ast.Name):
-            _check_name(node.id, node)
+            _check_name(node.id, node, binds=not isinstance(node.ctx, ast.Load))
         elif isinstance(node, ast.Attribute):
             _check_attribute(node.attr, node)
+            _check_method_reference(node, parents.get(node))
+            if not isinstance(node.ctx, ast.Load) and _rooted_at_np(node):
+                raise GuardError(f"np's attributes cannot be changed{_where(node)}")
         elif isinstance(node, (ast.FunctionDef, ast.Lambda)):
             if isinstance(node, ast.FunctionDef):
-                _check_name(node.name, node)
+                _check_name(node.name, node, binds=True)
             args = node.args
             for a in [*args.posonlyargs, *args.args, *args.kwonlyargs, args.vararg, args.kwarg]:
                 if a is not None:
-                    _check_name(a.arg, node)
+                    _check_name(a.arg, node, binds=True)
         elif isinstance(node, ast.comprehension) and node.is_async:
             raise GuardError(f"asynchronous comprehensions are not allowed{_where(node.target)}")
         elif isinstance(node, ast.Call):
@@ -156,5 +211,5 @@ def check_program(source: str) -> ast.Module:
         elif isinstance(node, ast.keyword) and node.arg is not None:
             _check_name(node.arg, node)
         elif isinstance(node, ast.ExceptHandler) and node.name:
-            _check_name(node.name, node)
+            _check_name(node.name, node, binds=True)
     return tree

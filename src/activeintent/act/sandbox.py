@@ -9,10 +9,12 @@ Layers, outermost first (``docs/security.md`` has the threat model):
    where namespaces are forbidden) the sandbox refuses to run programs unless the user passed
    ``--unsafe-no-isolation``; then, run as root, the program's process still chroots into an
    empty folder and drops to ``nobody``.
-2. Per program (``sandbox_worker``): a forked child in its own session under CPU-time, memory,
-   file-size, open-file and process limits, killed at the wall-time limit, with a seccomp
-   filter (``seccomp``) that refuses opening files, sockets, processes, signals, file-system
-   changes, mounts and namespaces.
+2. Per program (``sandbox_worker``): a fresh runner forked from a template that never sees a
+   program (no earlier program is in its memory), which forks the program's child: its own
+   session, CPU-time, memory, file-size, open-file and process limits, killed at the wall-time
+   limit, and a seccomp allow-list (``seccomp``) of the few calls the runtime needs. A program
+   is sent to a worker at most once (the runner acknowledges it), and the parent waits for it
+   no longer than its wall-time limit plus a grace: a stopped or stuck worker is killed then.
 3. ``guard.check_program``: an AST allow-list, checked here before anything runs and again in
    the child, and a restricted namespace (the robot API, a numpy subset as ``np``, safe
    builtins) — the first thing a program meets, but not what contains it.
@@ -71,6 +73,12 @@ _BOOT = "import sys; sys.path.insert(0, sys.argv[1]); from activeintent.act.sand
 WORKDIR_PREFIX = "activeintent-sandbox-"
 _WORKDIR_RE = re.compile(rf"^{WORKDIR_PREFIX}(?:(?P<pid>\d+)-)?[A-Za-z0-9_]+$")
 _MAX_REPLY_EXTRA = 1 << 16
+# A live worker forks a runner that acknowledges a request within milliseconds; past this the
+# worker is taken for dead or stopped (the program has not run) and is replaced once.
+ACK_TIMEOUT_S = 3.0
+# How long past the wall-time limit the parent waits for a reply: the runner only kills the
+# program, reaps it and writes. The sandbox's lock is never held longer for one program.
+REPLY_GRACE_S = 2.0
 
 ErrorKind = Literal["refused", "runtime", "cpu", "wall", "memory", "output", "crash", "sandbox"]
 _KILL_KINDS = frozenset({"cpu", "wall", "memory", "output", "crash"})
@@ -394,6 +402,17 @@ class Sandbox:
             return None
         return message if isinstance(message, dict) else None
 
+    def _send(self, data: bytes) -> dict | None:
+        """Send one request; the first message back: the runner's receipt, or the template's
+        report of a runner that failed before it (None: nothing answered in time)."""
+        assert self._proc is not None and self._proc.stdin is not None
+        try:
+            self._proc.stdin.write(struct.pack(">I", len(data)) + data)
+            self._proc.stdin.flush()
+        except (OSError, ValueError):
+            return None
+        return self._read(timeout=ACK_TIMEOUT_S)
+
     # ---- running programs ----------------------------------------------------------------
     def run(self, program: str, state: WorldState) -> SandboxResult:
         """Run ``program`` against the CaP robot API over ``state``. Never raises: a refused or
@@ -428,28 +447,40 @@ class Sandbox:
             reason = self.refusal()
             if reason is not None:
                 return SandboxResult(error=reason, error_kind="sandbox")
-            reply = None
-            for _attempt in range(2):  # a worker that died between programs is replaced once
+            taken = None
+            for _attempt in range(2):
                 self._ensure_started()
-                assert self._proc is not None and self._proc.stdin is not None
-                try:
-                    self._proc.stdin.write(struct.pack(">I", len(data)) + data)
-                    self._proc.stdin.flush()
-                    reply = self._read(timeout=self.limits.wall_seconds + 10.0)
-                except (OSError, ValueError):
-                    reply = None
-                if reply is not None:
+                taken = self._send(data)
+                if taken is not None:
                     break
-                try:
-                    died = self._proc.wait(timeout=0.5) is not None
-                except subprocess.TimeoutExpired:
-                    died = False
+                # No runner took the program (the worker died or stopped between programs), so
+                # it has not run: replace the worker and send it once more.
                 self._stop()
-                if not died:
-                    break  # alive but stuck: do not run the program a second time
-            if reply is None:
+            if taken is None or taken.get("accepted") is not True:
+                why = taken.get("message") if taken is not None else None
+                self._stop()
                 return SandboxResult(
-                    error="the sandbox worker stopped responding; the program was killed",
+                    error=clean_text(f"the sandbox worker did not take the program: {why or 'no answer'}",
+                                     MAX_ERROR_CHARS),
+                    error_kind="sandbox", elapsed_s=time.perf_counter() - started,
+                )
+            # The program may have run from here on: whatever happens, it is not sent again.
+            wait = self.limits.wall_seconds + REPLY_GRACE_S
+            waited = time.monotonic()
+            reply = self._read(timeout=wait)
+            if reply is None:
+                timed_out = time.monotonic() - waited >= wait
+                self._stop()  # a stopped or stuck worker is killed now, before the lock is let go
+                how = (f"did not answer within {wait:g} s (stopped or stuck) and was killed" if timed_out
+                       else "died or answered nonsense while running the program")
+                return SandboxResult(
+                    error=f"the sandbox worker {how}; the program was not run again",
+                    error_kind="sandbox", elapsed_s=time.perf_counter() - started,
+                )
+            if reply.get("status") == "lost":
+                self._stop()  # the runner may have left half a message in the pipe
+                return SandboxResult(
+                    error=clean_text(reply.get("message") or "the sandbox's runner was lost", MAX_ERROR_CHARS),
                     error_kind="sandbox", elapsed_s=time.perf_counter() - started,
                 )
         elapsed = time.perf_counter() - started

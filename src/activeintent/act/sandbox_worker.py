@@ -2,22 +2,29 @@
 
 The parent starts it once (see ``sandbox``): normally inside bubblewrap namespaces, always with
 ``python -I``, an environment built from scratch and no inherited descriptors. It imports numpy
-and the world model, warms every code path a program may touch, then loops: read a request
-(length-prefixed JSON on stdin), fork a child that runs one program, collect its result
-(capped) within the wall-time limit, kill the child, reply.
+and the world model and warms every code path a program may touch. From then on it is a
+*template* that never reads a request: for each program it forks a fresh *runner*, which reads
+one request (length-prefixed JSON on stdin), tells the parent it took it, forks the program's
+child, collects its result (capped) within the wall-time limit, kills the child, replies and
+exits. Every program therefore starts from the template's clean heap: no earlier program's
+source, positions or output can be found in its memory, and nothing a program did outlives its
+runner. The template reports a runner that died without replying (killed by its program, say),
+so the parent never has to guess whether a program ran.
 
-The child, before running untrusted code: starts a new session (own process group), points
-stdin/stdout/stderr at /dev/null, keeps only the result pipe (fd 3); if it runs as root (only
-possible without namespaces), chroots into an empty read-only directory and drops to
-``nobody``; sets RLIMIT_CPU, RLIMIT_AS, RLIMIT_FSIZE = 0, RLIMIT_NOFILE = 4, RLIMIT_NPROC = 0
-and RLIMIT_CORE = 0; and last installs the seccomp filter of ``seccomp`` (no open, socket,
-fork, exec, kill, ptrace, file-system change, mount, namespace, IPC, limit raising).
+The child, before running untrusted code: starts a new session (own process group), dies with
+its runner (``PR_SET_PDEATHSIG``), points stdin/stdout/stderr at /dev/null, keeps only the
+result pipe (fd 3); if it runs as root (only possible without namespaces), chroots into an
+empty read-only directory and drops to ``nobody``; sets RLIMIT_CPU, RLIMIT_AS,
+RLIMIT_FSIZE = 0, RLIMIT_NOFILE = 4, RLIMIT_NPROC = 0 and RLIMIT_CORE = 0; and last installs
+the seccomp allow-list of ``seccomp`` (memory, writing to open descriptors, exiting, clocks and
+little else).
 """
 
 from __future__ import annotations
 
 import ast
 import builtins
+import ctypes
 import json
 import os
 import resource
@@ -42,22 +49,52 @@ NOBODY = 65534
 MAX_MESSAGE_CHARS = 500
 MAX_REQUEST_BYTES = 64 << 20
 SECCOMP = Seccomp()  # built (and libc loaded) before any child is forked
+_LIBC = ctypes.CDLL(None, use_errno=True)
+_PR_SET_PDEATHSIG = 1
+# Exit codes of a runner that the template reads (a runner never exits 0 without replying).
+RUNNER_REPLIED, RUNNER_EOF = 0, 3
 
 
-def read_message(stream: Any) -> dict | None:
-    header = stream.read(4)
+def _read_exactly(fd: int, size: int) -> bytes:
+    """Unbuffered, so that a runner takes exactly one request off the shared stdin."""
+    chunks, left = [], size
+    while left:
+        chunk = os.read(fd, min(left, 1 << 20))
+        if not chunk:
+            break
+        chunks.append(chunk)
+        left -= len(chunk)
+    return b"".join(chunks)
+
+
+def read_message(fd: int) -> dict | None:
+    header = _read_exactly(fd, 4)
     if len(header) < 4:
         return None
     (size,) = struct.unpack(">I", header)
     if size > MAX_REQUEST_BYTES:
+        raise ValueError(f"request of {size} bytes")
+    data = _read_exactly(fd, size)
+    if len(data) < size:
         return None
-    return json.loads(stream.read(size))
+    message = json.loads(data)
+    if not isinstance(message, dict):
+        raise ValueError("request is not an object")
+    return message
 
 
-def write_message(stream: Any, message: dict) -> None:
+def write_message(fd: int, message: dict) -> None:
     data = json.dumps(message).encode()
-    stream.write(struct.pack(">I", len(data)) + data)
-    stream.flush()
+    view = memoryview(struct.pack(">I", len(data)) + data)
+    while view:
+        view = view[os.write(fd, view):]
+
+
+def _die_with_parent(parent: int) -> None:
+    """SIGKILL this process when its parent ends (and end now if it already has)."""
+    _LIBC.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    if os.getppid() != parent:
+        os._exit(70)
 
 
 def _vm_bytes() -> int:
@@ -108,7 +145,7 @@ def run_program(source: str, positions: dict, guard: bool) -> dict:
     }
 
 
-def _confine(limits: dict, vm_bytes: int, use_seccomp: bool) -> None:
+def _confine(limits: dict, vm_bytes: int, use_seccomp: bool, runner: int) -> None:
     os.setsid()
     devnull = os.open(os.devnull, os.O_RDWR)
     for fd in (0, 1, 2):
@@ -121,6 +158,9 @@ def _confine(limits: dict, vm_bytes: int, use_seccomp: bool) -> None:
         os.setgroups([])
         os.setgid(NOBODY)
         os.setuid(NOBODY)
+    # After the uid change (which clears it): a program that outlived its runner (which it might
+    # kill without seccomp) would be free of the wall-time limit; the filter keeps it set.
+    _die_with_parent(runner)
     cpu = int(limits["cpu_seconds"])
     memory = vm_bytes + int(limits["memory_mb"]) * (1 << 20)
     resource.setrlimit(resource.RLIMIT_CPU, (cpu, cpu + 1))
@@ -133,7 +173,7 @@ def _confine(limits: dict, vm_bytes: int, use_seccomp: bool) -> None:
         SECCOMP.install()  # last: it forbids setrlimit, chroot, open, ...
 
 
-def _child(request: dict, write_fd: int, vm_bytes: int) -> None:
+def _child(request: dict, write_fd: int, vm_bytes: int, runner: int) -> None:
     os.dup2(write_fd, RESULT_FD)
     if not request.get("guard", True):
         # Test mode without the allow-list: the usual attack modules are loaded before the
@@ -141,7 +181,7 @@ def _child(request: dict, write_fd: int, vm_bytes: int) -> None:
         import ctypes  # noqa: F401
         import socket  # noqa: F401
         import subprocess  # noqa: F401
-    _confine(request["limits"], vm_bytes, bool(request.get("seccomp", True)))
+    _confine(request["limits"], vm_bytes, bool(request.get("seccomp", True)), runner)
     result = run_program(request["program"], request["positions"], request.get("guard", True))
     data = json.dumps(result).encode()
     cap = int(request["limits"]["max_output_bytes"])
@@ -173,11 +213,12 @@ def handle(request: dict, vm_bytes: int) -> dict:
     limits = request["limits"]
     read_fd, write_fd = os.pipe()
     started = time.perf_counter()
+    runner = os.getpid()
     pid = os.fork()
     if pid == 0:  # child: never returns
         try:
             os.close(read_fd)
-            _child(request, write_fd, vm_bytes)
+            _child(request, write_fd, vm_bytes, runner)
         except BaseException:  # noqa: BLE001 - confinement failed: report no result
             os._exit(70)
         os._exit(0)
@@ -222,11 +263,49 @@ def handle(request: dict, vm_bytes: int) -> dict:
     return {"status": "killed", "kind": kind, "message": message, "elapsed_s": elapsed}
 
 
+def run_one(stdout: int, template: int) -> int:
+    """A runner: take one request, acknowledge it, run it in a confined child, reply."""
+    _die_with_parent(template)
+    request = read_message(0)
+    if request is None:
+        return RUNNER_EOF
+    # From here on the parent knows the program may have run: it will not send it again.
+    write_message(stdout, {"accepted": True})
+    write_message(stdout, handle(request, _vm_bytes()))
+    return RUNNER_REPLIED
+
+
+def _lost_runner(status: int) -> dict:
+    how = (f"was killed by {signal.Signals(os.WTERMSIG(status)).name}" if os.WIFSIGNALED(status)
+           else f"ended with exit code {os.WEXITSTATUS(status)}")
+    return {"status": "lost", "message": f"the sandbox's runner {how} before replying; the program was not run again"}
+
+
+def serve(stdout: int) -> None:
+    """The template's loop: one fresh runner per request, forked from this clean process."""
+    template = os.getpid()
+    while True:
+        pid = os.fork()
+        if pid == 0:
+            code = 70
+            try:
+                code = run_one(stdout, template)
+            except BaseException:  # noqa: BLE001 - a malformed request: reported by the template
+                pass
+            os._exit(code)
+        _, status = os.waitpid(pid, 0)
+        if os.WIFEXITED(status) and os.WEXITSTATUS(status) == RUNNER_EOF:
+            return
+        if not (os.WIFEXITED(status) and os.WEXITSTATUS(status) == RUNNER_REPLIED):
+            write_message(stdout, _lost_runner(status))
+
+
 def main() -> None:
     if os.getuid() == 0:  # only without namespaces: the children chroot into an empty folder
         os.mkdir(JAIL, 0o555)
-    stdin, stdout = sys.stdin.buffer, sys.stdout.buffer
+    stdout = os.dup(sys.stdout.fileno())
     sys.stdout = sys.stderr  # nothing but protocol messages may reach the parent's pipe
+    os.dup2(sys.stderr.fileno(), 1)
     # Warm up every code path a program may touch, so children import nothing after forking.
     run_program(
         "p = get_obj_pos('red block')\nput_first_on_second('red block', 'blue bowl')\n"
@@ -236,8 +315,7 @@ def main() -> None:
         True,
     )
     write_message(stdout, {"ready": True, "pid": os.getpid(), "uid": os.getuid(), "seccomp": SECCOMP.available})
-    while (request := read_message(stdin)) is not None:
-        write_message(stdout, handle(request, _vm_bytes()))
+    serve(stdout)
 
 
 if __name__ == "__main__":
