@@ -277,3 +277,18 @@ def test_tower_order_moves():
     assert not moved
     assert away("h2-alphabetical-tower", tower, PutOn(block="red block", target="blue block"))[0]
     assert not away("h2-alphabetical-tower", s1, PutOn(block="red block", target="green block"))[0]
+
+
+def test_the_suite_is_written_with_the_world_and_intention_helpers_only():
+    """No goal vocabulary (learners/) and no other suite: else its coverage would be true by construction."""
+    import ast
+    from pathlib import Path
+
+    import activeintent.intentions.suites.heldout2 as module
+
+    tree = ast.parse(Path(module.__file__).read_text())
+    imported = [n.module or "" for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]
+    imported += [a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names]
+    ours = [m for m in imported if m.startswith("activeintent")]
+    assert ours and all(m.startswith(("activeintent.world", "activeintent.intentions.")) for m in ours), ours
+    assert not any(m.startswith(("activeintent.learners", "activeintent.bench")) for m in imported), imported
