@@ -16,7 +16,7 @@ import re
 from collections import Counter
 from functools import lru_cache
 
-from activeintent.learners.lang.expr import NODES, QUANTS, Goal, all_clauses
+from activeintent.learners.lang.expr import NODES, Goal, all_clauses
 
 MIN_SCORE = 0.45
 STOP = {"the", "a", "an", "is", "are", "be", "should", "to", "of", "on", "in", "and", "it", "its", "their",
@@ -111,8 +111,11 @@ def language_summary(examples: int = 12) -> dict:
     return {
         "grammar": ["goal → clause [& clause [& clause]] [& every other block stays]",
                     "clause → quantifier selector relation | structure selector",
-                    f"quantifier → {' | '.join(QUANTS)}",
-                    "bits = Σ over nodes log2(choices); prior P(z) ∝ 2^-bits",
+                    "quantifier → every | none | (exactly | at-least) (1 | 2)",
+                    "structure → shape [in an order] [at a place]",
+                    "bits L(z): a uniform choice at every choice point (n clauses: n bits; a later clause's blocks: "
+                    "the same / the others / named anew, log2 3 bits); prior P(z) ∝ 2^-L(z) (docs/bayes.md)",
+                    "node bits below: which type, then which parameter (for structures: the mean over orders and places)",
                     f"the learner starts from the {KEEP} shortest distinct goals; after each answer "
                     "neighbours of its likely goals (and with --llm a model's goals) join the belief"],
         "nodes": kinds,
