@@ -132,3 +132,18 @@ def test_an_unknown_intention_is_a_clear_error():
 
     out = CliRunner().invoke(app, ["coverage", "--intentions", "no-such-thing"])
     assert out.exit_code == 2 and "Unknown intention" in out.output
+
+
+def test_the_committed_coverage_comes_out_of_the_code():
+    """docs/results/coverage: the rows of two intentions re-measured equal the committed ones."""
+    import json
+    from pathlib import Path
+
+    from activeintent.suites import resolve
+
+    committed = json.loads((Path(__file__).resolve().parents[2] / "docs/results/coverage/coverage.json").read_text())
+    rows = {r["intention"]: r for r in committed["intentions"]}
+    for name in ("stack", "dev-warm-on-cool"):
+        again = cov.coverage(resolve(name), start_keys=cov.start_space_keys()).row()
+        assert {k: again[k] for k in ("goal", "success", "selection_success", "bits", "prior_rank")} == {
+            k: rows[name][k] for k in ("goal", "success", "selection_success", "bits", "prior_rank")}, name
