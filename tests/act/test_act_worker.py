@@ -171,18 +171,30 @@ def _state(pid: int) -> str:
         return "gone"
 
 
-def _after_program(sandbox, taken_by: int) -> tuple[int, int]:
-    """(template, runner) between programs, once the runner that took the last program has
-    replied: the template and the fresh runner it forked for the next request (host pids)."""
+def _started(pid: int) -> int:
+    """Start time of a process, in clock ticks since boot (-1 when it is gone)."""
+    try:
+        return int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[19])
+    except (OSError, IndexError, ValueError):
+        return -1
+
+
+def _after_program(sandbox, started_after: int = -1) -> tuple[int, list[int]]:
+    """The template and its live runners started after tick ``started_after`` (host pids)."""
     deadline = time.monotonic() + 10.0
+    template, fresh = -1, []
     while time.monotonic() < deadline:
         pythons = [pid for pid in descendants(sandbox.worker_pid) if _comm(pid).startswith("python")]
         templates = [p for p in pythons if _ppid(p) not in pythons]
-        children = [p for p in pythons if templates and _ppid(p) == templates[0] and _state(p) not in ("Z", "gone")]
-        if len(templates) == 1 and len(children) == 1 and children[0] != taken_by:
-            return templates[0], children[0]
-        time.sleep(0.05)  # the runner replies before it exits; then the template forks the next
-    raise AssertionError(f"no idle template and runner below the sandbox: {pythons}")
+        if len(templates) == 1:
+            template = templates[0]
+            fresh = [p for p in pythons if _ppid(p) == template and _state(p) not in ("Z", "gone")
+                     and _started(p) > started_after]
+            if fresh:
+                return template, fresh
+        time.sleep(0.05)  # the template forks the next runner once the last one has replied
+    assert template > 0, "no template below the sandbox"
+    return template, fresh
 
 
 def _memory_holds(pid: int, needle: bytes) -> int:
@@ -206,11 +218,15 @@ def test_the_template_holds_no_program(sandbox, state):
     it is in the memory of the template every later program is forked from, nor in the runner
     waiting for the next request."""
     assert sandbox.run(BENIGN, state).ok
-    _, first_runner = _after_program(sandbox, -1)
     marker = f"MARK{uuid.uuid4().hex}"
     result = sandbox.run(_marked_program(marker), state)
     assert result.ok and result.said == [marker]
-    for pid in _after_program(sandbox, first_runner):
+    # One runner at a time (the template waits for each): once another program has been taken,
+    # the runner of the marked one has exited; every runner alive now was forked after it.
+    assert sandbox.run(BENIGN, state).ok
+    template, runners = _after_program(sandbox)
+    assert runners, "no runner below the template"
+    for pid in [template, *runners]:
         try:
             hits = _memory_holds(pid, marker.encode())
         except PermissionError as e:
