@@ -226,10 +226,16 @@ def test_the_template_holds_no_program(sandbox, state):
     assert sandbox.run(BENIGN, state).ok
     template, runners = _after_program(sandbox)
     assert runners, "no runner below the template"
+    scanned = []
     for pid in [template, *runners]:
         try:
             hits = _memory_holds(pid, marker.encode())
+            readable = _memory_holds(pid, b"activeintent.act.sandbox_worker")
         except PermissionError as e:
             pytest.skip(f"this user may not read the worker's memory: {e}")
+        except (FileNotFoundError, ProcessLookupError):
+            continue  # a runner that took the last program exited while being read: it holds nothing now
         assert hits == 0, f"{hits} copies of the program in the memory of {_comm(pid)} {pid}"
-        assert _memory_holds(pid, b"activeintent.act.sandbox_worker") > 0, "the scan reads nothing"
+        assert readable > 0, "the scan reads nothing"
+        scanned.append(pid)
+    assert template in scanned
