@@ -130,6 +130,10 @@ class Structure(Node):
     def score(self, f: Facts, g: Group, p: str) -> float:
         return float(self.holds(f, g, p))
 
+    def judge(self, f: Facts, g: Group, p: str) -> tuple[bool, float]:
+        """(holds, score) of a non-empty group (one call, so that a structure can share work)."""
+        return self.holds(f, g, p), float(self.score(f, g, p))
+
     def moved_ok(self, fb: Facts, fa: Facts, g: Group, b: str, p: str) -> bool:
         return True
 
@@ -435,6 +439,17 @@ REGIONS = {
 }
 
 
+CORNER_CELL = {"back left corner": "top left corner", "back right corner": "top right corner",
+               "front left corner": "bottom left corner", "front right corner": "bottom right corner"}
+
+
+def in_region(f: Facts, b: str, region: str) -> bool:
+    """REGIONS[region](f.xy[b]), reading a corner from the state's own cell names (the same
+    grid: the hot path asks this for every block, corner and state)."""
+    cell = CORNER_CELL.get(region)
+    return f.cell[b] == cell if cell is not None else REGIONS[region](f.xy[b])
+
+
 def region_points(region: str) -> list[tuple[float, float]]:
     """The grid points inside ``region``, nearest its centre first."""
     return list(_region_points(region))
@@ -456,7 +471,7 @@ class InRegion(Relation):
         return f"in the {p} of the table (front = near the person, back = far side; not in a bowl)"
 
     def ok(self, f, b, p):
-        return b in f.on_table and f.below[b] is None and REGIONS[p](f.xy[b])
+        return b in f.on_table and f.below[b] is None and in_region(f, b, p)
 
     def targets(self, state, b, p):
         return free_points(state, region_points(p), b, 10)
@@ -801,7 +816,7 @@ class Corners(Structure):
     def _corner(self, f, b):
         if b not in f.on_table or f.below[b] is not None:
             return None
-        return next((c for c in CORNERS if REGIONS[c](f.xy[b])), None)
+        return next((c for c in CORNERS if in_region(f, b, c)), None)
 
     def _ok(self, f, g, b):
         c = self._corner(f, b)
@@ -991,12 +1006,33 @@ class Placed(Structure):
         if place in PLACE_AREA:
             return sum(PLACE_AREA[place](f.xy[b]) for b in down) / len(g)
         if place == "a-corner":
-            return max((sum(REGIONS[c](f.xy[b]) for b in down) for c in CORNERS), default=0) / len(g)
+            return max((sum(in_region(f, b, c) for b in down) for c in CORNERS), default=0) / len(g)
         return max((sum(f.next_to(b, w) for b in down) for w in f.bowls), default=0) / len(g)
 
     def holds(self, f, g, p):
         order, _, place = p.partition("@")
         return self.inner.holds(f, g, order) and (not place or self._share(f, g, place) == 1.0)
+
+    def judge(self, f, g, p):
+        """As holds and score, with the inner shape's verdict shared by every place and the
+        place's share by every shape and order (memoised on the state: the hot path)."""
+        order, _, place = p.partition("@")
+        k = ("placed-inner", self.key, order, g)
+        inner = f.memo.get(k)
+        if inner is None:
+            inner = f.memo[k] = (self.inner.holds(f, g, order), float(self.inner.score(f, g, order)))
+        if not place:
+            return inner
+        share = self._share_memo(f, g, place)
+        return inner[0] and share == 1.0, (inner[1] + share) / 2
+
+    @classmethod
+    def _share_memo(cls, f: Facts, g: Group, place: str) -> float:
+        k = ("placed-share", place, g)
+        share = f.memo.get(k)
+        if share is None:
+            share = f.memo[k] = cls._share(f, g, place)
+        return share
 
     def score(self, f, g, p):
         order, _, place = p.partition("@")
@@ -1007,7 +1043,8 @@ class Placed(Structure):
         order, _, place = p.partition("@")
         if not self.inner.moved_ok(fb, fa, g, b, order):
             return False
-        return not place or self._share(fa, (b,), place) == 1.0 or self._share(fa, g, place) >= self._share(fb, g, place)
+        return (not place or self._share_memo(fa, (b,), place) == 1.0
+                or self._share_memo(fa, g, place) >= self._share_memo(fb, g, place))
 
     def possible(self, g, objects, p):
         order, _, place = p.partition("@")
@@ -1243,8 +1280,7 @@ class Form:
         k = ("form-judge", self.struct, self.stp, g)
         got = f.memo.get(k)
         if got is None:
-            got = f.memo[k] = ((True, 1.0) if not g else
-                               (self.structure.holds(f, g, self.stp), float(self.structure.score(f, g, self.stp))))
+            got = f.memo[k] = (True, 1.0) if not g else self.structure.judge(f, g, self.stp)
         return got
 
     def holds(self, f: Facts) -> bool:

@@ -73,6 +73,11 @@ class Compiled:
         self.e_q = np.array([Q_CODE[c.quant.rsplit("-", 1)[0] if c.quant[-1].isdigit() else c.quant] for c in each], int)
         self.e_n = np.array([int(c.quant[-1]) if c.quant[-1].isdigit() else 0 for c in each], int)
         self.f_sel = np.array([sels[(clauses[i].sel, clauses[i].sp)] for i in self.forms], int)
+        shapes: dict[tuple[str, str], int] = {}
+        for i in self.forms:
+            shapes.setdefault((clauses[i].struct, clauses[i].stp), len(shapes))
+        self.shapes = [(NODES["structure"][st], stp) for st, stp in shapes]
+        self.f_shape = [shapes[(clauses[i].struct, clauses[i].stp)] for i in self.forms]
         self._possible: dict[tuple[str, ...], np.ndarray] = {}
         self._tag = ("lang", next(_TOKENS))  # unique per judge (an id() can be reused)
 
@@ -126,10 +131,45 @@ class Compiled:
                 q == 2, np.clip(1 - np.abs(cnt - m) / np.maximum(szc, m), 0, 1), np.minimum(cnt, m) / np.maximum(m, 1))))
             holds[self.each] = h
             score[self.each] = s
-        for i in self.forms:
-            holds[i], score[i] = self.clauses[i].judge(f)
+        if self.forms:
+            self._judge_forms(f, holds, score)
         got = f.memo[key] = (holds, score)
         return got
+
+    def _form_groups(self, f: Facts) -> tuple[list[tuple[str, ...]], list[int]]:
+        """The distinct groups the selectors pick in ``f`` and, per selector, its group's index."""
+        key = self._tag + ("groups",)
+        got = f.memo.get(key)
+        if got is None:
+            gid: dict[tuple[str, ...], int] = {}
+            groups, sel_gid = [], []
+            for row in self._matrices(f)[0].tolist():
+                g = tuple(b for b, x in zip(f.blocks, row, strict=True) if x)
+                if g not in gid:
+                    gid[g] = len(groups)
+                    groups.append(g)
+                sel_gid.append(gid[g])
+            got = f.memo[key] = (groups, sel_gid)
+        return got
+
+    def _judge_forms(self, f: Facts, holds: np.ndarray, score: np.ndarray) -> None:
+        """Every structure clause, each (shape, group) judged once: clauses whose selectors pick
+        the same blocks share the verdict (as Form.judge, without its per-clause lookups)."""
+        groups, sel_gid = self._form_groups(f)
+        done: dict[int, tuple[bool, float]] = {}
+        n_groups = len(groups)
+        for i, si, sh in zip(self.forms, self.f_sel.tolist(), self.f_shape, strict=True):
+            g_i = sel_gid[si]
+            g = groups[g_i]
+            if not g:  # an empty group: holds, score 1
+                score[i] = 1.0
+                continue
+            k = sh * n_groups + g_i
+            got = done.get(k)
+            if got is None:
+                struct, stp = self.shapes[sh]
+                got = done[k] = struct.judge(f, g, stp)
+            holds[i], score[i] = got
 
     def eval(self, f: Facts) -> tuple[np.ndarray, np.ndarray]:
         """(holds, score) per goal."""
@@ -161,13 +201,28 @@ class Compiled:
                 q = self.e_q
                 off[self.each] = ing & (((q == 0) & ~r) | ((q == 1) & r) | ((q == 2) & r & (cnt > self.e_n)))
                 inside[self.each] = ing
-            for i in self.forms:
-                c = self.clauses[i]
-                g = c.group_f(fa)
-                inside[i] = b in g
-                off[i] = inside[i] and c.moved_off(fb, fa, b)
+            if self.forms:
+                self._moved_forms(fb, fa, b, off, inside)
         fa.memo[key] = (fb, (off, inside))
         return off, inside
+
+    def _moved_forms(self, fb: Facts, fa: Facts, b: str, off: np.ndarray, inside: np.ndarray) -> None:
+        """As Form.moved_off for every structure clause, each (shape, group) asked once."""
+        groups, sel_gid = self._form_groups(fa)
+        done: dict[int, bool] = {}
+        n_groups = len(groups)
+        for i, si, sh in zip(self.forms, self.f_sel.tolist(), self.f_shape, strict=True):
+            g_i = sel_gid[si]
+            g = groups[g_i]
+            if b not in g:
+                continue
+            inside[i] = True
+            k = sh * n_groups + g_i
+            got = done.get(k)
+            if got is None:
+                struct, stp = self.shapes[sh]
+                got = done[k] = not struct.moved_ok(fb, fa, g, b, stp)
+            off[i] = got
 
     def moved_off(self, fb: Facts, fa: Facts, b: str) -> np.ndarray:
         key = self._tag + ("om", b)
