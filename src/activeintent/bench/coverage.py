@@ -308,11 +308,9 @@ def cached_coverage(intention: Intention, seed: int = 0) -> dict:
     space: the language's sources and node types), intention (its class's source) and seed."""
     import hashlib
     import inspect
-    import json
-    import os
     from pathlib import Path
 
-    from activeintent.learners.lang.space import cache_path
+    from activeintent.learners.lang.space import cache_path, cached_json
 
     try:
         source = inspect.getsource(type(intention))
@@ -320,20 +318,8 @@ def cached_coverage(intention: Intention, seed: int = 0) -> dict:
         source = repr(type(intention))
     tag = hashlib.sha256("\0".join([Path(__file__).read_text(), intention.name, intention.description, source,
                                     getattr(getattr(intention, "goal", None), "key", "")]).encode()).hexdigest()[:16]
-    path = cache_path(f"coverage-{seed}-{tag}")
-    try:
-        return json.loads(path.read_text())
-    except (OSError, ValueError):
-        pass
-    row = coverage(intention, seed=seed, start_keys=start_space_keys()).row()
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(json.dumps(row))
-        os.replace(tmp, path)
-    except OSError:
-        pass
-    return row
+    return cached_json(cache_path(f"coverage-{seed}-{tag}"),
+                       lambda: coverage(intention, seed=seed, start_keys=start_space_keys()).row())
 
 
 def oracle_of(intentions: dict[str, Intention], progress: Callable[[str], None] | None = None) -> dict[str, dict]:

@@ -19,6 +19,7 @@ import itertools
 import json
 import os
 import time
+from collections.abc import Callable
 from functools import lru_cache
 from pathlib import Path
 
@@ -315,6 +316,25 @@ def cache_path(tag: str) -> Path:
     return root / f"lang-space-{digest.hexdigest()[:16]}-{tag}.json"
 
 
+def cached_json(path: Path, make: Callable[[], dict]) -> dict:
+    """``make()``, kept at ``path``: read when there (and readable), else made and written
+    atomically (a temporary file, then a rename: a reader never sees half a file); a cache that
+    cannot be written is skipped, never fatal."""
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        pass
+    value = make()
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(value))
+        os.replace(tmp, path)
+    except OSError:
+        pass
+    return value
+
+
 def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scenes: int = 40) -> dict:
     """Enumerate, de-duplicate, keep the ``keep`` shortest; returns keys and counts."""
     t0 = time.time()
@@ -382,20 +402,7 @@ def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scen
 
 def space_info(seed: int = 0, keep: int = 3000) -> dict:
     """The built space (from the disk cache when the sources have not changed)."""
-    path = cache_path(f"{seed}-{keep}")
-    try:
-        return json.loads(path.read_text())
-    except (OSError, ValueError):
-        pass
-    info = build_space(seed, keep)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(json.dumps(info))
-        os.replace(tmp, path)
-    except OSError:
-        pass
-    return info
+    return cached_json(cache_path(f"{seed}-{keep}"), lambda: build_space(seed, keep))
 
 
 @lru_cache(maxsize=4)
