@@ -420,6 +420,10 @@ class Beside(Relation):
         return [PutNextTo(block=b, target=o, side=s)] + free_points(state, _near_first(state, o, pts), b, 5)
 
 
+CORNER_CELL = {"back left corner": "top left corner", "back right corner": "top right corner",
+               "front left corner": "bottom left corner", "front right corner": "bottom right corner"}
+
+
 def _cell(name: str):
     return lambda xy: table_position_name(xy) == name
 
@@ -432,15 +436,8 @@ REGIONS = {
     "back strip": lambda xy: xy[1] > -0.4,
     "front strip": lambda xy: xy[1] < -0.6,
     "centre": lambda xy: abs(xy[0]) < 0.1 and abs(xy[1] + 0.5) < 0.1,
-    "back left corner": _cell("top left corner"),
-    "back right corner": _cell("top right corner"),
-    "front left corner": _cell("bottom left corner"),
-    "front right corner": _cell("bottom right corner"),
+    **{corner: _cell(cell) for corner, cell in CORNER_CELL.items()},
 }
-
-
-CORNER_CELL = {"back left corner": "top left corner", "back right corner": "top right corner",
-               "front left corner": "bottom left corner", "front right corner": "bottom right corner"}
 
 
 def in_region(f: Facts, b: str, region: str) -> bool:
@@ -1010,12 +1007,15 @@ class Placed(Structure):
         return max((sum(f.next_to(b, w) for b in down) for w in f.bowls), default=0) / len(g)
 
     def holds(self, f, g, p):
-        order, _, place = p.partition("@")
-        return self.inner.holds(f, g, order) and (not place or self._share(f, g, place) == 1.0)
+        return self.judge(f, g, p)[0]
+
+    def score(self, f, g, p):
+        return self.judge(f, g, p)[1]
 
     def judge(self, f, g, p):
-        """As holds and score, with the inner shape's verdict shared by every place and the
-        place's share by every shape and order (memoised on the state: the hot path)."""
+        """(holds, score): the inner shape's, and for a place also all the group there (the
+        score the mean of the two). The inner verdict is shared by every place and the place's
+        share by every shape and order (memoised on the state: the hot path)."""
         order, _, place = p.partition("@")
         k = ("placed-inner", self.key, order, g)
         inner = f.memo.get(k)
@@ -1033,11 +1033,6 @@ class Placed(Structure):
         if share is None:
             share = f.memo[k] = cls._share(f, g, place)
         return share
-
-    def score(self, f, g, p):
-        order, _, place = p.partition("@")
-        s = float(self.inner.score(f, g, order))
-        return s if not place else (s + self._share(f, g, place)) / 2
 
     def moved_ok(self, fb, fa, g, b, p):
         order, _, place = p.partition("@")

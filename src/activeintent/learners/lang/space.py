@@ -73,7 +73,7 @@ class Compiled:
         self.e_rel = np.array([rels[(c.rel, c.rp)] for c in each], int)
         self.e_q = np.array([Q_CODE[c.quant.rsplit("-", 1)[0] if c.quant[-1].isdigit() else c.quant] for c in each], int)
         self.e_n = np.array([int(c.quant[-1]) if c.quant[-1].isdigit() else 0 for c in each], int)
-        self.f_sel = np.array([sels[(clauses[i].sel, clauses[i].sp)] for i in self.forms], int)
+        self.f_sel = [sels[(clauses[i].sel, clauses[i].sp)] for i in self.forms]
         shapes: dict[tuple[str, str], int] = {}
         for i in self.forms:
             shapes.setdefault((clauses[i].struct, clauses[i].stp), len(shapes))
@@ -153,22 +153,25 @@ class Compiled:
             got = f.memo[key] = (groups, sel_gid)
         return got
 
+    def _form_cases(self, f: Facts):
+        """Per structure clause: its index, its group in ``f``, its shape (structure, parameter)
+        and a key shared by the clauses of the same shape and group (asked once per key)."""
+        groups, sel_gid = self._form_groups(f)
+        n_groups = len(groups)
+        for i, si, sh in zip(self.forms, self.f_sel, self.f_shape, strict=True):
+            g_i = sel_gid[si]
+            yield i, groups[g_i], self.shapes[sh], sh * n_groups + g_i
+
     def _judge_forms(self, f: Facts, holds: np.ndarray, score: np.ndarray) -> None:
         """Every structure clause, each (shape, group) judged once: clauses whose selectors pick
         the same blocks share the verdict (as Form.judge, without its per-clause lookups)."""
-        groups, sel_gid = self._form_groups(f)
         done: dict[int, tuple[bool, float]] = {}
-        n_groups = len(groups)
-        for i, si, sh in zip(self.forms, self.f_sel.tolist(), self.f_shape, strict=True):
-            g_i = sel_gid[si]
-            g = groups[g_i]
+        for i, g, (struct, stp), k in self._form_cases(f):
             if not g:  # an empty group: holds, score 1
                 score[i] = 1.0
                 continue
-            k = sh * n_groups + g_i
             got = done.get(k)
             if got is None:
-                struct, stp = self.shapes[sh]
                 got = done[k] = struct.judge(f, g, stp)
             holds[i], score[i] = got
 
@@ -209,19 +212,13 @@ class Compiled:
 
     def _moved_forms(self, fb: Facts, fa: Facts, b: str, off: np.ndarray, inside: np.ndarray) -> None:
         """As Form.moved_off for every structure clause, each (shape, group) asked once."""
-        groups, sel_gid = self._form_groups(fa)
         done: dict[int, bool] = {}
-        n_groups = len(groups)
-        for i, si, sh in zip(self.forms, self.f_sel.tolist(), self.f_shape, strict=True):
-            g_i = sel_gid[si]
-            g = groups[g_i]
+        for i, g, (struct, stp), k in self._form_cases(fa):
             if b not in g:
                 continue
             inside[i] = True
-            k = sh * n_groups + g_i
             got = done.get(k)
             if got is None:
-                struct, stp = self.shapes[sh]
                 got = done[k] = not struct.moved_ok(fb, fa, g, b, stp)
             off[i] = got
 
