@@ -209,6 +209,39 @@ def test_frames_have_shape_and_change_with_motion(demo):
     assert red.sum() > 10
 
 
+def test_a_frame_is_what_one_z_buffer_over_the_table_and_the_scene_draws(demo):
+    """The table is drawn apart and composited by depth; the result is the single-pass picture."""
+    import pybullet as p
+
+    from activeintent.sim import render
+    from activeintent.sim.assets import create_table
+
+    size = (200, 150)
+    drawn = render.renderer_for(demo.object_names)
+    whole = render.SceneRenderer(demo.object_names)
+    try:
+        create_table(whole.client, collide=False)  # the table in the scene's own client: one pass
+        for t in (0.0, demo.duration / 3, demo.duration):
+            k = demo.tick_at(t)
+            whole.draw(demo.object_poses[k], demo.joint_positions[k], size)  # poses the bodies
+            one_pass, _ = render._camera_image(whole.client, size, whole.view)
+            assert np.array_equal(drawn.draw(demo.object_poses[k], demo.joint_positions[k], size), one_pass)
+    finally:
+        whole.close()
+    assert p.isConnected(drawn.client)
+
+
+def test_frames_drawn_in_worker_processes_are_the_same(demo):
+    from activeintent.sim.render import render_frames, warm_render_pool
+
+    times = frame_times(demo, 2)
+    assert warm_render_pool(2)  # pytest's main module can be imported: the processes start
+    here = list(render_frames(demo, times, (96, 72), workers=1))
+    there = list(render_frames(demo, times, (96, 72), workers=2))
+    assert len(here) == len(there) == len(times) > 8  # more than one chunk
+    assert all(np.array_equal(a, b) for a, b in zip(here, there, strict=True))
+
+
 def test_render_state(demo):
     img = render_state(demo.initial_state, size=(120, 120))
     assert img.shape == (120, 120, 3) and img.std() > 5
@@ -221,7 +254,15 @@ def test_exports_are_readable(demo, tmp_path, suffix):
     reader = iio.get_reader(path) if suffix == ".gif" else iio.get_reader(path, format="FFMPEG")
     frames = [np.asarray(f) for f in reader]
     reader.close()
-    assert len(frames) == len(frame_times(demo, fps))
+    expected = len(frame_times(demo, fps))
+    if suffix == ".gif":  # the GIF writer merges identical consecutive frames, adding up their durations
+        from PIL import Image, ImageSequence
+
+        with Image.open(path) as gif:
+            total_ms = sum(f.info["duration"] for f in ImageSequence.Iterator(gif))
+        assert len(frames) <= expected and total_ms == pytest.approx(expected * 1000 / fps, abs=expected)
+    else:
+        assert len(frames) == expected
     assert frames[0].shape[:2] == (96, 96)
 
 

@@ -38,7 +38,12 @@ def test_serve_names_the_design_and_configures_the_study(tmp_path, monkeypatch):
     assert "free rule" in said and "not scored" in said and "color-match" not in said
     free = served[-1].state.manager.config
     assert free.design == "free-rule" and free.intention is None and free.show_estimate == "hidden"
-    assert free.video_size == (480, 480)
+    assert free.video_size == (800, 600)  # every block at least 40 px (tests/sim/test_camera.py)
+    assert "model none" in said  # a method that needs no model gets none unless --llm is given
+    bad = runner.invoke(app, ["serve", "--method", "bayes-stop", "--video-size", "800x", "--out", str(tmp_path)])
+    assert bad.exit_code != 0 and "WIDTHxHEIGHT" in " ".join(bad.output.split())
+    res = runner.invoke(app, ["serve", "--method", "bayes-stop", "--video-size", "640x360", "--out", str(tmp_path)])
+    assert res.exit_code == 0 and served[-1].state.manager.config.video_size == (640, 360), res.output
     res = runner.invoke(app, ["serve", "--method", "bayes-preference", "--intention", "color-match",
                               "--show-estimate", "after-answer", "--video-size", "360", "--out", str(tmp_path)])
     assert res.exit_code == 0, res.output

@@ -254,7 +254,7 @@ def test_openapi_describes_the_api(live_server):
     assert config == {"study": False, "consent": None, "require_pid": False,
                       "url_parameters": ["pid", "PROLIFIC_PID", "STUDY_ID", "SESSION_ID"], "method": "bayes-stop", "signal": "stop", "rounds": 1, "design": "free-rule",
                       "intention": None, "intention_description": None, "show_estimate": "hidden", "fps": 10,
-                      "video_size": [480, 480]}
+                      "video_size": [800, 600]}
 
 
 def test_stopping_the_server_cancels_sessions_in_progress(live_server, http):

@@ -24,7 +24,7 @@ def test_study_defaults_free_rule_hidden_guess_and_readable_videos():
     config = StudyConfig(method="bayes-stop", signal="stop", rounds=2)
     assert config.design == "free-rule" and config.intention is None and config.intention_description is None
     assert config.show_estimate == "hidden"
-    assert config.video_size == (480, 480)
+    assert config.video_size == (800, 600)  # every block at least 40 px (tests/sim/test_camera.py)
     assert json.loads(config.model_dump_json())["design"] == "free-rule"  # recorded in session.json
     assigned = StudyConfig(method="bayes-stop", signal="stop", rounds=2, intention="color-match")
     assert assigned.design == "assigned-rule"

@@ -23,22 +23,36 @@ from activeintent.sim.robot import BASE_POSITION, BASE_YAW, REST_POSE
 from activeintent.world.state import WorldState
 from activeintent.world.trajectory import Trajectory
 
-# An oblique view from the front edge of the table towards the robot, as in Code as Policies:
-# the top side of the workspace (near the robot) is at the top of the image, x grows to the right.
-CAMERA_EYE = (0.0, -1.28, 0.78)
-CAMERA_TARGET = (0.0, -0.49, 0.0)
+# A telephoto view from the front, 40 degrees above the table: nearly orthographic, so blocks at
+# the back look almost as large as at the front; the whole 60 cm workspace spans the image width,
+# and the arm at rest (hand 40-55 cm above the workspace's middle) falls behind the back edge.
+# The top of the image is the side near the robot, x grows to the right.
+CAMERA_TARGET = (0.0, -0.45, 0.0)
+CAMERA_ELEVATION = 40.0  # degrees above the table
+CAMERA_DISTANCE = 3.0  # metres from the target
+CAMERA_HFOV = 14.0  # degrees, horizontal: every image shows the same width, whatever its aspect
 CAMERA_UP = (0.0, 0.0, 1.0)
-CAMERA_FOV = 45.0
 LIGHT_DIRECTION = (0.3, -0.6, 1.0)
+_el = np.radians(CAMERA_ELEVATION)
+CAMERA_EYE = (CAMERA_TARGET[0], CAMERA_TARGET[1] - CAMERA_DISTANCE * float(np.cos(_el)),
+              CAMERA_TARGET[2] + CAMERA_DISTANCE * float(np.sin(_el)))
+
+
+def projection(size: tuple[int, int]) -> list[float]:
+    """The camera's projection for a ``(width, height)`` image: fixed horizontal field of view."""
+    w, h = size
+    vfov = 2.0 * np.degrees(np.arctan(np.tan(np.radians(CAMERA_HFOV) / 2.0) * h / w))
+    return p.computeProjectionMatrixFOV(float(vfov), w / h, 0.5, 6.0)
+
+
 _MAX_CACHED = 4
 
 
 def _camera_image(client: int, size: tuple[int, int], view) -> tuple[np.ndarray, np.ndarray]:
     """RGB (H, W, 3) and depth (H, W) of what ``client`` holds, from the one camera."""
     w, h = size
-    proj = p.computeProjectionMatrixFOV(CAMERA_FOV, w / h, 0.05, 5.0)
     _, _, rgba, depth, _ = p.getCameraImage(
-        w, h, view, proj, shadow=0, lightDirection=LIGHT_DIRECTION,
+        w, h, view, projection(size), shadow=0, lightDirection=LIGHT_DIRECTION,
         renderer=p.ER_TINY_RENDERER, flags=p.ER_NO_SEGMENTATION_MASK, physicsClientId=client,
     )
     rgb = np.asarray(rgba, dtype=np.uint8).reshape(h, w, 4)[:, :, :3]
@@ -146,3 +160,84 @@ def render_state(state: WorldState, size: tuple[int, int] = (240, 240)) -> np.nd
     names = state.names
     poses = np.array([[*state.positions[n], 0.0, 0.0, 0.0, 1.0] for n in names])
     return renderer_for(names).draw(poses, None, size)
+
+
+# -- frames of a video in worker processes ---------------------------------------------------
+# TinyRenderer holds the GIL while it draws, so frames are drawn in parallel only in processes.
+CHUNK_FRAMES = 8  # frames per task: small enough that the writer starts early
+_pool = None
+_pool_workers = 0
+
+
+def _draw_chunk(names: list[str], poses: np.ndarray, joints: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    renderer = renderer_for(names)
+    return np.stack([renderer.draw(poses[i], joints[i], size) for i in range(len(poses))])
+
+
+def _render_pool(workers: int):
+    """The shared pool of ``workers`` render processes (started once, on first use)."""
+    global _pool, _pool_workers
+    if _pool is None or _pool_workers != workers:
+        import multiprocessing as mp
+        from concurrent.futures import ProcessPoolExecutor
+
+        if _pool is not None:
+            _pool.shutdown(wait=False, cancel_futures=True)
+        _pool = ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"))
+        _pool_workers = workers
+    return _pool
+
+
+def _forget_pool() -> None:
+    global _pool
+    _pool = None
+
+
+def warm_render_pool(workers: int) -> bool:
+    """Start the render processes now (each takes ~1 s to import PyBullet), not at the first video.
+    False when they cannot start (e.g. a script without ``if __name__ == "__main__":``, which
+    spawned processes need): videos are then drawn in this process."""
+    if workers <= 1:
+        return False
+    from concurrent.futures.process import BrokenProcessPool
+
+    pool = _render_pool(workers)
+    try:
+        for f in [pool.submit(_check_size, (16, 16)) for _ in range(workers)]:
+            f.result()
+    except (BrokenProcessPool, RuntimeError, OSError):
+        _forget_pool()
+        return False
+    return True
+
+
+def render_frames(traj: Trajectory, times: np.ndarray, size: tuple[int, int] = (240, 240),
+                  workers: int = 1):
+    """The frames of τ at ``times``, in order, drawn by ``workers`` processes (1: this one).
+    Identical whatever ``workers`` is: each frame depends on its logged tick only."""
+    size = _check_size(size)
+    if traj.n_ticks == 0:
+        raise ValueError("the trajectory has no ticks to render")
+    ticks = [traj.tick_at(float(t)) for t in times]
+    if workers <= 1 or len(ticks) <= CHUNK_FRAMES:
+        renderer = renderer_for(traj.object_names)
+        for k in ticks:
+            yield renderer.draw(traj.object_poses[k], traj.joint_positions[k], size)
+        return
+    from concurrent.futures.process import BrokenProcessPool
+
+    pool = _render_pool(workers)
+    chunks = [ticks[i:i + CHUNK_FRAMES] for i in range(0, len(ticks), CHUNK_FRAMES)]
+    futures = [pool.submit(_draw_chunk, list(traj.object_names), traj.object_poses[c], traj.joint_positions[c],
+                           size) for c in chunks]
+    for n, future in enumerate(futures):
+        try:
+            frames = future.result()
+        except BrokenProcessPool:  # a worker died: the rest in this process, the pool restarted next time
+            _forget_pool()
+            renderer = renderer_for(traj.object_names)
+            for c in chunks[n:]:
+                for k in c:
+                    yield renderer.draw(traj.object_poses[k], traj.joint_positions[k], size)
+            return
+        yield from frames

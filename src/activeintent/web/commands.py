@@ -11,6 +11,7 @@ import typer
 
 from activeintent import options as opt
 from activeintent.options import D
+from activeintent.web.basics import VIDEO_SIZE_TEXT
 
 
 class ShowEstimate(StrEnum):
@@ -38,8 +39,8 @@ def serve(
     out: Annotated[Path, typer.Option("--out", help="Sessions are saved in OUT/<session-id>/")] = Path("runs/web"),
     show_estimate: Annotated[ShowEstimate | None, typer.Option("--show-estimate", help="The learner's current guess: never shown (hidden, the default), shown between rounds after each answer (after-answer), or above the videos from round 2 on (always); never before the first answer")] = None,
     study: Annotated[Path | None, typer.Option("--study", help="A study file (.json or .toml): consent text, completion code and redirect, and the conditions (method × rule × guess display) participants are assigned to in a balanced way; replaces --method, --intention and --show-estimate")] = None,
-    video_size: Annotated[int, typer.Option("--video-size", min=64, max=1024, help="Width and height of the videos in pixels (larger takes longer to render before each round)")] = 480,
-    llm: opt.Llm = D.llm,
+    video_size: Annotated[str, typer.Option("--video-size", help="Videos' WIDTHxHEIGHT in pixels, or one number for a square (at the default every block is at least 40 px wide; larger takes longer to render before each round)")] = VIDEO_SIZE_TEXT,
+    llm: Annotated[str | None, typer.Option("--llm", help="LLM: embedded | gguf:/path.gguf | openai:<model> | none (default: embedded for methods that need a model, none for the others)")] = None,
     vlm: opt.Vlm = None,
     base_url: opt.BaseUrl = None,
     cache: opt.Cache = None,
@@ -70,12 +71,17 @@ def serve(
     from activeintent.runner import check_options
     from activeintent.suites import resolve as resolve_intention
     from activeintent.web import transport
+    from activeintent.web.basics import parse_video_size
     from activeintent.web.limits import Limits
     from activeintent.web.server import create_app, runner_builder
     from activeintent.web.session import StudyConfig
     from activeintent.web.study import StudyFileError, load_study
 
-    extra = dict(llm=llm, vlm=vlm, base_url=base_url, cache=cache,
+    try:
+        size = parse_video_size(video_size)
+    except ValueError as err:
+        raise typer.BadParameter(str(err), param_hint="--video-size") from None
+    extra = dict(vlm=vlm, base_url=base_url, cache=cache,
                  cache_mode=cache_mode, executor=executor, retriever=retriever, plugins=list(plugin or []))
     study_file = None
     if study is not None:
@@ -94,11 +100,13 @@ def serve(
         cells = [("single", method or "bayes-preference", intention, intention_file,
                   (show_estimate or ShowEstimate.hidden).value)]
     configs: dict[str, StudyConfig] = {}
+    models: dict[str, str] = {}  # condition -> its --llm: a method that needs no model gets none
     for name, m, rule_name, rule_file, shown in cells:
         try:
+            models[name] = llm or ("embedded" if get_method(m).needs_llm else "none")
             # options and the assigned rule are checked now so a typo fails before anyone opens the page
             check_options(opt.run_options(method=m, budget=rounds, intention=rule_name,
-                                          intention_file=rule_file, **extra))
+                                          intention_file=rule_file, llm=models[name], **extra))
             rule = resolve_intention(rule_name, rule_file) if rule_name or rule_file else None
             signal = get_method(m).signal
         except (ValueError, IntentionError, FileNotFoundError) as err:
@@ -107,7 +115,7 @@ def serve(
         configs[name] = StudyConfig(
             method=m, signal=signal, rounds=rounds, intention=rule.name if rule else None, intention_file=rule_file,
             intention_description=(rule.description or rule.name) if rule else None, show_estimate=shown,
-            video_size=(video_size, video_size), out_dir=out, seed=seed, answer_timeout=answer_timeout,
+            video_size=size, out_dir=out, seed=seed, answer_timeout=answer_timeout,
             max_sessions=max_sessions)
     config = next(iter(configs.values()))
     limits = Limits(max_sessions_per_client=max_sessions_per_client,
@@ -117,9 +125,11 @@ def serve(
                     max_connections_per_client=max_connections_per_client, max_connections=max_connections)
     if opt.check_only():
         return
-    conditions = {name: (c, runner_builder(c, **extra)) for name, c in configs.items()} if study_file else None
+    conditions = ({name: (c, runner_builder(c, llm=models[name], **extra)) for name, c in configs.items()}
+                  if study_file else None)
+    first = next(iter(configs))
     try:
-        app = create_app(config, runner_builder(config, **extra), limits=limits, study=study_file,
+        app = create_app(config, runner_builder(config, llm=models[first], **extra), limits=limits, study=study_file,
                          conditions=conditions)
     except ValueError as err:  # e.g. an unreadable OUT/assignment.json
         raise typer.BadParameter(str(err), param_hint="--out") from None
@@ -130,7 +140,7 @@ def serve(
                       f"sessions saved in {out}/")
         for name, c in configs.items():
             console.print(f"  {name}: {c.method} ({c.signal}), {c.design} "
-                          f"{c.intention or ''}, guess {c.show_estimate}")
+                          f"{c.intention or ''}, guess {c.show_estimate}, model {models[name]}")
         console.print("Participants are assigned to the least-filled condition (counts in "
                       f"{out}/assignment.json); a participant ID is "
                       + ("required" if study_file.require_pid else "optional") + " (?pid=… or ?PROLIFIC_PID=…).")
@@ -149,7 +159,8 @@ def serve(
     else:
         console.print("Design: free rule — each participant picks their own rule; success is not scored "
                       "(their own verdict is in the questionnaire).")
-    console.print(f"The learner's guess: {config.show_estimate}; videos {video_size}×{video_size} px.")
+    console.print(f"The learner's guess: {config.show_estimate}; model {models[first]}; "
+                  f"videos {size[0]}×{size[1]} px.")
     console.print(f"Open http://{shown}:{port}/ — API schema at /openapi.json. Ctrl-C stops.")
     if host not in ("127.0.0.1", "localhost", "::1"):
         console.print(f"[yellow]Listening on {host}: anyone who can reach this address can take part.[/]")

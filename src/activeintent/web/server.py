@@ -277,6 +277,10 @@ def create_app(
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
+        from activeintent.sim.render import warm_render_pool
+
+        # the render processes start now, not during the first participant's first wait
+        await asyncio.to_thread(warm_render_pool, config.render_workers)
         sweeper = asyncio.create_task(_sweep(guard))
         try:
             yield

@@ -23,6 +23,7 @@ from __future__ import annotations
 import hashlib
 import hmac
 import json
+import os
 import re
 import secrets
 import threading
@@ -44,7 +45,7 @@ from activeintent.users.human import (
     video_duration,
     video_frames,
 )
-from activeintent.web.basics import EstimateMode, write_json
+from activeintent.web.basics import VIDEO_SIZE, EstimateMode, write_json
 from activeintent.web.errors import ApiError
 
 SESSION_ID = re.compile(r"^[0-9a-f]{16}$")
@@ -77,9 +78,12 @@ class StudyConfig(BaseModel):
     out_dir: Path = Path("out/web")
     seed: int = Field(0, description="session n (0, 1, …) runs with seed + n unless it asks for one")
     fps: int = Field(10, ge=1, le=60, description="frames per second of the videos")
-    video_size: tuple[int, int] = Field((480, 480), description="width, height of the videos in pixels")
+    video_size: tuple[int, int] = Field(VIDEO_SIZE, description="width, height of the videos in pixels (at the "
+                                        "default every block is at least 40 px wide)")
     answer_timeout: float | None = Field(1800.0, description="seconds to wait for one answer")
     max_sessions: int = Field(4, ge=1, description="sessions in progress at once")
+    render_workers: int = Field(default_factory=lambda: min(2, os.cpu_count() or 1), ge=1, le=32,
+                                description="processes that draw the videos' frames (shared by all sessions)")
 
     @computed_field  # type: ignore[prop-decorator]
     @property
@@ -380,7 +384,8 @@ class WebSession:
         from activeintent.sim.video import export_video
 
         fps = self.config.fps
-        export_video(traj, self.dir / f"{name}.webm", fps=fps, size=self.config.video_size)
+        export_video(traj, self.dir / f"{name}.webm", fps=fps, size=self.config.video_size,
+                     workers=self.config.render_workers)
         return VideoInfo(
             label=label,
             file=f"{name}.webm",

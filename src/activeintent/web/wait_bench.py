@@ -21,6 +21,7 @@ import typer
 
 from activeintent import options as opt
 from activeintent.options import D
+from activeintent.web.basics import VIDEO_SIZE_TEXT, parse_video_size
 
 POLL_S = 0.02
 READY = ("waiting-for-answer", "finished", "failed", "cancelled")
@@ -32,7 +33,7 @@ def _answer(signal: str, round_: int) -> dict:
     return {"kind": "stop", "round": round_, "action": "looks_good"}
 
 
-def measure_waits(method: str, rounds: int, video_size: int, seed: int, out: Path,
+def measure_waits(method: str, rounds: int, video_size: tuple[int, int], seed: int, out: Path,
                   intention: str | None = None, timeout_s: float = 900.0) -> dict:
     """Seconds from each answer until the next round (or the end) is ready, for one session."""
     from fastapi.testclient import TestClient
@@ -42,7 +43,7 @@ def measure_waits(method: str, rounds: int, video_size: int, seed: int, out: Pat
     from activeintent.web.session import StudyConfig
 
     config = StudyConfig(method=method, signal=get_method(method).signal, rounds=rounds, out_dir=out,
-                         intention=intention, video_size=(video_size, video_size))
+                         intention=intention, video_size=video_size)
     app = create_app(config, runner_builder(config, llm="none"))
     waits: list[float] = []
     with TestClient(app) as client:
@@ -73,7 +74,7 @@ def measure_waits(method: str, rounds: int, video_size: int, seed: int, out: Pat
         if state["status"] != "finished":
             raise RuntimeError(f"the session ended {state['status']}")
     w = np.array(waits)
-    return {"method": method, "signal": config.signal, "rounds": rounds, "video_px": video_size,
+    return {"method": method, "signal": config.signal, "rounds": rounds, "video_px": list(video_size),
             "first_round_s": round(first, 2), "waits_s": [round(x, 2) for x in waits],
             "p50_s": round(float(np.percentile(w, 50)), 2) if len(w) else None,
             "p90_s": round(float(np.percentile(w, 90)), 2) if len(w) else None,
@@ -83,7 +84,7 @@ def measure_waits(method: str, rounds: int, video_size: int, seed: int, out: Pat
 def web_bench(
     method: Annotated[str, typer.Option("--method", help="A method of the web study (see `activeintent methods`)")] = "bayes-stop",
     rounds: Annotated[int, typer.Option("--rounds", min=2, max=30, help="Rounds of the session (waits: rounds − 1)")] = 5,
-    video_size: Annotated[int, typer.Option("--video-size", min=64, max=1024, help="Video width and height in pixels")] = 480,
+    video_size: Annotated[str, typer.Option("--video-size", help="Videos' WIDTHxHEIGHT in pixels, or one number for a square (default: the study's)")] = VIDEO_SIZE_TEXT,
     sessions: Annotated[int, typer.Option("--sessions", min=1, max=20, help="Sessions, one after another (seeds 0, 1, …)")] = 2,
     intention: Annotated[str | None, typer.Option("--intention", help="An assigned rule (default: free rule)")] = None,
     seed: opt.Seed = D.seed,
@@ -93,22 +94,27 @@ def web_bench(
     from rich.console import Console
 
     console = Console(stderr=as_json)
+    try:
+        size = parse_video_size(video_size)
+    except ValueError as err:
+        raise typer.BadParameter(str(err), param_hint="--video-size") from None
+    px = f"{size[0]}×{size[1]} px"
     results = []
     with tempfile.TemporaryDirectory(prefix="web-bench-") as tmp:
         for n in range(sessions):
-            console.print(f"session {n + 1}/{sessions}: {method}, {rounds} rounds, {video_size} px …")
+            console.print(f"session {n + 1}/{sessions}: {method}, {rounds} rounds, {px} …")
             try:
-                results.append(measure_waits(method, rounds, video_size, seed + n, Path(tmp) / f"s{n}", intention))
+                results.append(measure_waits(method, rounds, size, seed + n, Path(tmp) / f"s{n}", intention))
             except (ValueError, RuntimeError, TimeoutError) as err:
                 console.print(f"[red]error:[/red] {err}")
                 raise typer.Exit(2) from None
     waits = np.array([w for r in results for w in r["waits_s"]])
-    summary = {"method": method, "video_px": video_size, "sessions": sessions, "waits": len(waits),
+    summary = {"method": method, "video_px": list(size), "sessions": sessions, "waits": len(waits),
                "p50_s": round(float(np.percentile(waits, 50)), 2), "p90_s": round(float(np.percentile(waits, 90)), 2),
                "first_round_s": [r["first_round_s"] for r in results], "target_p90_s": 3.0, "per_session": results}
     if as_json:
         print(json.dumps(summary))
         return
-    console.print(f"between-round wait, {method} at {video_size} px: p50 {summary['p50_s']:.2f} s, "
+    console.print(f"between-round wait, {method} at {px}: p50 {summary['p50_s']:.2f} s, "
                   f"p90 {summary['p90_s']:.2f} s over {len(waits)} waits (target p90 ≤ 3 s); first round "
                   f"{', '.join(f'{x:.1f}' for x in summary['first_round_s'])} s (simulator start included)")

@@ -210,6 +210,12 @@ const Study = (() => {
 
   // Log what the participant does with a video (play, pause, seeks, ends).
   function watchVideo(video, label, roundOf) {
+    // the page takes the video's own size (CSS variables), so nothing is drawn smaller than rendered
+    video.addEventListener("loadedmetadata", () => {
+      if (!video.videoWidth) return;
+      document.documentElement.style.setProperty("--video-width", `${video.videoWidth}px`);
+      document.documentElement.style.setProperty("--video-aspect", `${video.videoWidth} / ${video.videoHeight}`);
+    });
     for (const type of ["loadedmetadata", "play", "playing", "pause", "seeked", "ended", "error"]) {
       video.addEventListener(type, () =>
         log(`video_${type}`, { video: label, time: video.currentTime, duration: video.duration }, roundOf()));
