@@ -299,3 +299,29 @@ def test_a_stopped_round_video_ends_at_the_stop_with_a_marker(tmp_path):
     before = sum(1 for k in range(1000) if k / 10 < stop)
     assert not any(red[:before]) and all(red[before:]) and len(frames) >= before + 1
     assert len(frames) <= before + 10
+
+
+def test_render_processes_leave_when_their_parent_is_killed(tmp_path):
+    import os
+    import subprocess
+    import sys
+    import time
+
+    script = tmp_path / "warm.py"
+    script.write_text("from activeintent.sim.render import warm_render_pool\n"
+                      "if __name__ == '__main__':\n"
+                      "    import time\n    print(warm_render_pool(2), flush=True)\n    time.sleep(120)\n")
+    parent = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True)
+    try:
+        assert parent.stdout.readline().strip() == "True"
+        kids = subprocess.run(["pgrep", "-P", str(parent.pid)], capture_output=True, text=True).stdout.split()
+        workers = [k for k in kids if "spawn_main" in open(f"/proc/{k}/cmdline").read()]
+        assert len(workers) == 2
+    finally:
+        parent.kill()
+        parent.wait()
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(os.path.exists(f"/proc/{k}") for k in workers):
+        time.sleep(0.2)
+    # a zombie (reaped by init soon) has an empty command line
+    assert not [k for k in workers if os.path.exists(f"/proc/{k}") and open(f"/proc/{k}/cmdline").read()]

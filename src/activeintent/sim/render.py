@@ -174,6 +174,21 @@ def _draw_chunk(names: list[str], poses: np.ndarray, joints: np.ndarray, size: t
     return np.stack([renderer.draw(poses[i], joints[i], size) for i in range(len(poses))])
 
 
+def _exit_with(parent: int) -> None:
+    """In a render process: leave as soon as the process that started it is gone (killed
+    servers must not leave their render processes behind)."""
+    import os
+    import threading
+    import time
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(0.5)
+        os._exit(0)
+
+    threading.Thread(target=watch, name="parent-watch", daemon=True).start()
+
+
 def _render_pool(workers: int):
     """The shared pool of ``workers`` render processes (started once, on first use)."""
     global _pool, _pool_workers
@@ -183,7 +198,10 @@ def _render_pool(workers: int):
 
         if _pool is not None:
             _pool.shutdown(wait=False, cancel_futures=True)
-        _pool = ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"))
+        import os
+
+        _pool = ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
+                                    initializer=_exit_with, initargs=(os.getpid(),))
         _pool_workers = workers
     return _pool
 
