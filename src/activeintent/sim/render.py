@@ -146,12 +146,7 @@ def _check_size(size: tuple[int, int]) -> tuple[int, int]:
 
 def render_frame(traj: Trajectory, t: float, size: tuple[int, int] = (240, 240)) -> np.ndarray:
     """RGB image (H, W, 3) uint8 of τ at time t seconds (clipped to the trajectory)."""
-    size = _check_size(size)
-    if traj.n_ticks == 0:
-        raise ValueError("the trajectory has no ticks to render")
-    tick = traj.tick_at(t)
-    renderer = renderer_for(traj.object_names)
-    return renderer.draw(traj.object_poses[tick], traj.joint_positions[tick], size)
+    return next(render_frames(traj, np.array([t]), size))
 
 
 def render_state(state: WorldState, size: tuple[int, int] = (240, 240)) -> np.ndarray:
@@ -194,12 +189,11 @@ def _render_pool(workers: int):
     global _pool, _pool_workers
     if _pool is None or _pool_workers != workers:
         import multiprocessing as mp
+        import os
         from concurrent.futures import ProcessPoolExecutor
 
         if _pool is not None:
             _pool.shutdown(wait=False, cancel_futures=True)
-        import os
-
         _pool = ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
                                     initializer=_exit_with, initargs=(os.getpid(),))
         _pool_workers = workers
@@ -229,6 +223,12 @@ def warm_render_pool(workers: int) -> bool:
     return True
 
 
+def _draw_here(traj: Trajectory, ticks: list[int], size: tuple[int, int]):
+    renderer = renderer_for(traj.object_names)
+    for k in ticks:
+        yield renderer.draw(traj.object_poses[k], traj.joint_positions[k], size)
+
+
 def render_frames(traj: Trajectory, times: np.ndarray, size: tuple[int, int] = (240, 240),
                   workers: int = 1):
     """The frames of τ at ``times``, in order, drawn by ``workers`` processes (1: this one).
@@ -238,9 +238,7 @@ def render_frames(traj: Trajectory, times: np.ndarray, size: tuple[int, int] = (
         raise ValueError("the trajectory has no ticks to render")
     ticks = [traj.tick_at(float(t)) for t in times]
     if workers <= 1 or len(ticks) <= CHUNK_FRAMES:
-        renderer = renderer_for(traj.object_names)
-        for k in ticks:
-            yield renderer.draw(traj.object_poses[k], traj.joint_positions[k], size)
+        yield from _draw_here(traj, ticks, size)
         return
     from concurrent.futures.process import BrokenProcessPool
 
@@ -253,9 +251,6 @@ def render_frames(traj: Trajectory, times: np.ndarray, size: tuple[int, int] = (
             frames = future.result()
         except BrokenProcessPool:  # a worker died: the rest in this process, the pool restarted next time
             _forget_pool()
-            renderer = renderer_for(traj.object_names)
-            for c in chunks[n:]:
-                for k in c:
-                    yield renderer.draw(traj.object_poses[k], traj.joint_positions[k], size)
+            yield from _draw_here(traj, [k for c in chunks[n:] for k in c], size)
             return
         yield from frames
