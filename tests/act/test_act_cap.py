@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import select
 import signal
 
 import numpy as np
@@ -183,6 +184,11 @@ def test_dead_worker_is_replaced(state):
     require_namespaces()
     with Sandbox(isolation="bwrap") as sb:
         os.killpg(sb.worker_pid, signal.SIGKILL)
+        # bwrap runs the worker in a session of its own that dies *after* bwrap (die-with-parent):
+        # wait until nothing holds the pipe, else the dying runner may still take the program.
+        sb._proc.wait(timeout=10)
+        fd = sb._proc.stdout.fileno()
+        assert select.select([fd], [], [], 10)[0] and os.read(fd, 1) == b""
         result = sb.run("put_first_on_second('red block', 'blue bowl')", state)
         assert result.ok and len(result.skills) == 1
 
