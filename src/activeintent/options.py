@@ -61,3 +61,18 @@ def run_options(**values) -> RunOptions:
             name = "--" + str(e["loc"][0]).replace("_", "-")
             msgs.append(f"{name}: {e['msg']} (got {e.get('input')!r})")
         raise ValueError("; ".join(msgs)) from None
+
+
+def _video_size(text: str) -> tuple[int, int]:
+    from activeintent.web.basics import parse_video_size
+
+    try:
+        return parse_video_size(text)
+    except ValueError as err:
+        raise typer.BadParameter(str(err)) from None
+
+
+VideoSize = Annotated[str, typer.Option(
+    "--video-size", callback=_video_size,
+    help="Videos' WIDTHxHEIGHT in pixels (64-2048 each), or one number for a square; at the default every "
+    "block is at least 40 px wide, larger takes longer to render before each round")]

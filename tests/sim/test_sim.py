@@ -325,3 +325,26 @@ def test_render_processes_leave_when_their_parent_is_killed(tmp_path):
         time.sleep(0.2)
     # a zombie (reaped by init soon) has an empty command line
     assert not [k for k in workers if os.path.exists(f"/proc/{k}") and open(f"/proc/{k}/cmdline").read()]
+
+
+def test_a_pool_that_cannot_start_is_tried_once(demo, tmp_path):
+    """Render processes that cannot start (here: an interpreter that exits at once) are tried
+    once; later videos are drawn in this process without paying for another failed start."""
+    import pickle
+    import subprocess
+    import sys
+
+    (tmp_path / "demo.pkl").write_bytes(pickle.dumps(demo))
+    script = tmp_path / "broken.py"
+    script.write_text(
+        "import multiprocessing, pickle\nimport activeintent.sim.render as r\n"
+        "from activeintent.sim.video import frame_times\n"
+        "if __name__ == '__main__':\n"
+        "    multiprocessing.set_executable('/bin/false')\n"
+        "    tries = []\n    start = r._render_pool\n    r._render_pool = lambda w: tries.append(w) or start(w)\n"
+        "    first = r.warm_render_pool(2)\n"
+        f"    demo = pickle.loads(open({str(tmp_path / 'demo.pkl')!r}, 'rb').read())\n"
+        "    frames = list(r.render_frames(demo, frame_times(demo, 4), (64, 48), workers=2))\n"
+        "    print(first, r.warm_render_pool(2), len(frames) == len(frame_times(demo, 4)), len(tries))\n")
+    got = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert got.stdout.split() == ["False", "False", "True", "1"], got.stdout + got.stderr[-2000:]

@@ -9,6 +9,7 @@ import sys
 import time
 
 import httpx
+import pytest
 from typer.testing import CliRunner
 
 from activeintent.cli import app
@@ -52,6 +53,12 @@ def test_serve_names_the_design_and_configures_the_study(tmp_path, monkeypatch):
     assigned = served[-1].state.manager.config
     assert assigned.design == "assigned-rule" and assigned.intention == "color-match"
     assert assigned.show_estimate == "after-answer" and assigned.video_size == (360, 360)
+    from pydantic import ValidationError
+
+    from activeintent.web.session import StudyConfig
+
+    with pytest.raises(ValidationError, match="64-2048"):  # a study built in Python keeps the CLI's rule
+        StudyConfig(method="bayes-stop", signal="stop", rounds=3, video_size=(32, 4000))
 
 
 def test_serve_binds_loopback_and_answers(tmp_path):

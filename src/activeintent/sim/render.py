@@ -162,6 +162,8 @@ def render_state(state: WorldState, size: tuple[int, int] = (240, 240)) -> np.nd
 CHUNK_FRAMES = 8  # frames per task: small enough that the writer starts early
 _pool = None
 _pool_workers = 0
+_pool_unstartable = False  # the processes could not start once: they will not start later either
+_pool_delivered = False  # the pool has drawn frames at least once
 
 
 def _draw_chunk(names: list[str], poses: np.ndarray, joints: np.ndarray, size: tuple[int, int]) -> np.ndarray:
@@ -200,16 +202,22 @@ def _render_pool(workers: int):
     return _pool
 
 
-def _forget_pool() -> None:
-    global _pool
+def _mark_delivered() -> None:
+    global _pool_delivered
+    _pool_delivered = True
+
+
+def _forget_pool(unstartable: bool = False) -> None:
+    global _pool, _pool_unstartable
     _pool = None
+    _pool_unstartable = _pool_unstartable or unstartable
 
 
 def warm_render_pool(workers: int) -> bool:
     """Start the render processes now (each takes ~1 s to import PyBullet), not at the first video.
     False when they cannot start (e.g. a script without ``if __name__ == "__main__":``, which
     spawned processes need): videos are then drawn in this process."""
-    if workers <= 1:
+    if workers <= 1 or _pool_unstartable:
         return False
     from concurrent.futures.process import BrokenProcessPool
 
@@ -218,7 +226,7 @@ def warm_render_pool(workers: int) -> bool:
         for f in [pool.submit(_check_size, (16, 16)) for _ in range(workers)]:
             f.result()
     except (BrokenProcessPool, RuntimeError, OSError):
-        _forget_pool()
+        _forget_pool(unstartable=True)  # remembered: no video pays for another failed start
         return False
     return True
 
@@ -237,7 +245,7 @@ def render_frames(traj: Trajectory, times: np.ndarray, size: tuple[int, int] = (
     if traj.n_ticks == 0:
         raise ValueError("the trajectory has no ticks to render")
     ticks = [traj.tick_at(float(t)) for t in times]
-    if workers <= 1 or len(ticks) <= CHUNK_FRAMES:
+    if workers <= 1 or len(ticks) <= CHUNK_FRAMES or _pool_unstartable:
         yield from _draw_here(traj, ticks, size)
         return
     from concurrent.futures.process import BrokenProcessPool
@@ -250,7 +258,8 @@ def render_frames(traj: Trajectory, times: np.ndarray, size: tuple[int, int] = (
         try:
             frames = future.result()
         except BrokenProcessPool:  # a worker died: the rest in this process, the pool restarted next time
-            _forget_pool()
+            _forget_pool(unstartable=n == 0 and not _pool_delivered)  # never drew a frame: it cannot start
             yield from _draw_here(traj, [k for c in chunks[n:] for k in c], size)
             return
+        _mark_delivered()
         yield from frames

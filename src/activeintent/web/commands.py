@@ -39,7 +39,7 @@ def serve(
     out: Annotated[Path, typer.Option("--out", help="Sessions are saved in OUT/<session-id>/")] = Path("runs/web"),
     show_estimate: Annotated[ShowEstimate | None, typer.Option("--show-estimate", help="The learner's current guess: never shown (hidden, the default), shown between rounds after each answer (after-answer), or above the videos from round 2 on (always); never before the first answer")] = None,
     study: Annotated[Path | None, typer.Option("--study", help="A study file (.json or .toml): consent text, completion code and redirect, and the conditions (method × rule × guess display) participants are assigned to in a balanced way; replaces --method, --intention and --show-estimate")] = None,
-    video_size: Annotated[str, typer.Option("--video-size", help="Videos' WIDTHxHEIGHT in pixels, or one number for a square (at the default every block is at least 40 px wide; larger takes longer to render before each round)")] = VIDEO_SIZE_TEXT,
+    video_size: opt.VideoSize = VIDEO_SIZE_TEXT,
     llm: Annotated[str | None, typer.Option("--llm", help="LLM: embedded | gguf:/path.gguf | openai:<model> | none (default: embedded for methods that need a model, none for the others)")] = None,
     vlm: opt.Vlm = None,
     base_url: opt.BaseUrl = None,
@@ -71,16 +71,12 @@ def serve(
     from activeintent.runner import check_options
     from activeintent.suites import resolve as resolve_intention
     from activeintent.web import transport
-    from activeintent.web.basics import parse_video_size
     from activeintent.web.limits import Limits
     from activeintent.web.server import create_app, runner_builder
     from activeintent.web.session import StudyConfig
     from activeintent.web.study import StudyFileError, load_study
 
-    try:
-        size = parse_video_size(video_size)
-    except ValueError as err:
-        raise typer.BadParameter(str(err), param_hint="--video-size") from None
+    size = tuple(video_size)  # parsed by the option
     extra = dict(vlm=vlm, base_url=base_url, cache=cache,
                  cache_mode=cache_mode, executor=executor, retriever=retriever, plugins=list(plugin or []))
     study_file = None

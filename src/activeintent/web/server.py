@@ -280,7 +280,9 @@ def create_app(
         from activeintent.sim.render import warm_render_pool
 
         # the render processes start now, not during the first participant's first wait
-        await asyncio.to_thread(warm_render_pool, config.render_workers)
+        if not await asyncio.to_thread(warm_render_pool, config.render_workers) and config.render_workers > 1:
+            log.warning("the %d render processes could not start: every video is drawn in the server's "
+                        "own process (longer waits between rounds)", config.render_workers)
         sweeper = asyncio.create_task(_sweep(guard))
         try:
             yield

@@ -33,7 +33,7 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, Field, computed_field, model_validator
+from pydantic import BaseModel, Field, computed_field, field_validator, model_validator
 
 from activeintent.protocol import FORMAT_VERSION
 from activeintent.records import EpisodeRecorder, dumps
@@ -45,7 +45,7 @@ from activeintent.users.human import (
     video_duration,
     video_frames,
 )
-from activeintent.web.basics import VIDEO_SIZE, EstimateMode, write_json
+from activeintent.web.basics import VIDEO_SIZE, EstimateMode, parse_video_size, write_json
 from activeintent.web.errors import ApiError
 
 SESSION_ID = re.compile(r"^[0-9a-f]{16}$")
@@ -90,6 +90,11 @@ class StudyConfig(BaseModel):
     def design(self) -> Design:
         """assigned-rule when the study gives participants a rule, else free-rule."""
         return "assigned-rule" if self.intention or self.intention_file else "free-rule"
+
+    @field_validator("video_size")
+    @classmethod
+    def _video_size_in_range(cls, size: tuple[int, int]) -> tuple[int, int]:
+        return parse_video_size(f"{size[0]}x{size[1]}")  # the CLI's rule: 64-2048 pixels a side
 
     @model_validator(mode="after")
     def _describe_rule(self) -> StudyConfig:

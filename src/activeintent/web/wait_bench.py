@@ -21,7 +21,7 @@ import typer
 
 from activeintent import options as opt
 from activeintent.options import D
-from activeintent.web.basics import VIDEO_SIZE_TEXT, parse_video_size
+from activeintent.web.basics import VIDEO_SIZE_TEXT
 
 POLL_S = 0.02
 READY = ("waiting-for-answer", "finished", "failed", "cancelled")
@@ -84,7 +84,7 @@ def measure_waits(method: str, rounds: int, video_size: tuple[int, int], seed: i
 def web_bench(
     method: Annotated[str, typer.Option("--method", help="A method of the web study (see `activeintent methods`)")] = "bayes-stop",
     rounds: Annotated[int, typer.Option("--rounds", min=2, max=30, help="Rounds of the session (waits: rounds − 1)")] = 5,
-    video_size: Annotated[str, typer.Option("--video-size", help="Videos' WIDTHxHEIGHT in pixels, or one number for a square (default: the study's)")] = VIDEO_SIZE_TEXT,
+    video_size: opt.VideoSize = VIDEO_SIZE_TEXT,
     sessions: Annotated[int, typer.Option("--sessions", min=1, max=20, help="Sessions, one after another (seeds 0, 1, …)")] = 2,
     intention: Annotated[str | None, typer.Option("--intention", help="An assigned rule (default: free rule)")] = None,
     seed: opt.Seed = D.seed,
@@ -94,10 +94,7 @@ def web_bench(
     from rich.console import Console
 
     console = Console(stderr=as_json)
-    try:
-        size = parse_video_size(video_size)
-    except ValueError as err:
-        raise typer.BadParameter(str(err), param_hint="--video-size") from None
+    size = tuple(video_size)  # parsed by the option
     px = f"{size[0]}×{size[1]} px"
     results = []
     with tempfile.TemporaryDirectory(prefix="web-bench-") as tmp:
