@@ -9,7 +9,7 @@ import numpy as np
 import pybullet as p
 import pytest
 
-from activeintent.sim.render import LIGHT_DIRECTION, SceneRenderer, projection
+from activeintent.sim.render import SceneRenderer, camera_segmentation
 from activeintent.sim.robot import REST_POSE
 from activeintent.web.basics import VIDEO_SIZE
 from activeintent.world import BLOCK_SIZE, BOUNDS, COLOR_NAMES, WorldState, layout, sample_scene
@@ -27,11 +27,7 @@ def shot(renderer: SceneRenderer, state: WorldState, base) -> tuple[np.ndarray, 
     poses = np.array([[*state.positions[n], 0.0, 0.0, 0.0, 1.0] for n in renderer.object_names])
     renderer.draw(poses, REST, VIDEO_SIZE)  # poses the bodies and the joints
     p.resetBasePositionAndOrientation(renderer.robot, *base, physicsClientId=c)
-    w, h = VIDEO_SIZE
-    _, _, rgba, _, seg = p.getCameraImage(w, h, renderer.view, projection(VIDEO_SIZE), shadow=0,
-                                          lightDirection=LIGHT_DIRECTION, renderer=p.ER_TINY_RENDERER,
-                                          physicsClientId=c)
-    return np.asarray(rgba, np.uint8).reshape(h, w, 4)[:, :, :3], np.asarray(seg).reshape(h, w)
+    return camera_segmentation(c, VIDEO_SIZE, renderer.view)
 
 
 @pytest.fixture(scope="module")

@@ -48,15 +48,26 @@ def projection(size: tuple[int, int]) -> list[float]:
 _MAX_CACHED = 4
 
 
+def _camera(client: int, size: tuple[int, int], view, flags: int):
+    w, h = size
+    return p.getCameraImage(w, h, view, projection(size), shadow=0, lightDirection=LIGHT_DIRECTION,
+                            renderer=p.ER_TINY_RENDERER, flags=flags, physicsClientId=client)
+
+
 def _camera_image(client: int, size: tuple[int, int], view) -> tuple[np.ndarray, np.ndarray]:
     """RGB (H, W, 3) and depth (H, W) of what ``client`` holds, from the one camera."""
     w, h = size
-    _, _, rgba, depth, _ = p.getCameraImage(
-        w, h, view, projection(size), shadow=0, lightDirection=LIGHT_DIRECTION,
-        renderer=p.ER_TINY_RENDERER, flags=p.ER_NO_SEGMENTATION_MASK, physicsClientId=client,
-    )
+    _, _, rgba, depth, _ = _camera(client, size, view, p.ER_NO_SEGMENTATION_MASK)
     rgb = np.asarray(rgba, dtype=np.uint8).reshape(h, w, 4)[:, :, :3]
     return rgb, np.asarray(depth, dtype=np.float32).reshape(h, w)
+
+
+def camera_segmentation(client: int, size: tuple[int, int], view) -> tuple[np.ndarray, np.ndarray]:
+    """RGB (H, W, 3) and the body id of every pixel (H, W; -1: none), from the same camera
+    (for checks of what a video shows, e.g. how many pixels each block gets)."""
+    w, h = size
+    _, _, rgba, _, seg = _camera(client, size, view, 0)
+    return np.asarray(rgba, dtype=np.uint8).reshape(h, w, 4)[:, :, :3], np.asarray(seg).reshape(h, w)
 
 
 class TableBackdrop:
