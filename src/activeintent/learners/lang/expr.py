@@ -331,22 +331,24 @@ class OnTable(Relation):
         return free_points(state, _near_first(state, b, GRID), b, 8)
 
 
-NEAR_ANY = ("a-bowl", "a-block", "block-same-class", "block-other-class")
+# "next to any ...": the kind of object and, for blocks, its colour relation to the block placed
+NEAR_ANY = {"a-bowl": ("bowl", "any"), "a-block": ("block", "any"),
+            "block-same-class": ("block", "same-class"), "block-other-class": ("block", "other-class")}
 
 
 class NextTo(Relation):
     """Next to a named object, to the bowl of its own colour, or to any bowl / block (of a kin)."""
 
     key = "next-to"
-    params = ALL_OBJECTS + ("own-bowl",) + NEAR_ANY
+    params = ALL_OBJECTS + ("own-bowl",) + tuple(NEAR_ANY)
 
     def phrase(self, p):
         if p == "own-bowl":
             return "next to the bowl of its own colour"
         if p in NEAR_ANY:
-            kind, _, kin = p.partition("-")
-            return f"next to {'a bowl' if kind == 'a' and kin == 'bowl' else 'another block'}" + (
-                f" {KIN_WORDS[kin]}" if kind == "block" else "")
+            kind, kin = NEAR_ANY[p]
+            return "next to a bowl" if kind == "bowl" else " ".join(
+                w for w in ("next to another block", KIN_WORDS[kin]) if w)
         return f"next to the {p}"
 
     def refers(self, p):
@@ -355,11 +357,9 @@ class NextTo(Relation):
     def _targets(self, b, objects, p) -> list[str]:
         if p == "own-bowl":
             return [own_bowl(b)] if own_bowl(b) in objects else []
-        if p == "a-bowl":
-            return [o for o in objects if kind_of(o) == "bowl"]
         if p in NEAR_ANY:
-            kin = "any" if p == "a-block" else p.partition("-")[2]
-            return [o for o in objects if kind_of(o) == "block" and o != b and _kin(b, o, kin)]
+            kind, kin = NEAR_ANY[p]
+            return [o for o in objects if kind_of(o) == kind and o != b and _kin(b, o, kin)]
         return [p] if p in objects and p != b else []
 
     def ok(self, f, b, p):
@@ -452,12 +452,16 @@ def region_points(region: str) -> list[tuple[float, float]]:
     return list(_region_points(region))
 
 
-@functools.cache  # planners ask on every step; the grid never changes
-def _region_points(region: str) -> tuple[tuple[float, float], ...]:
-    inside = REGIONS[region]
+def _area_points(inside) -> tuple[tuple[float, float], ...]:
+    """The grid points ``inside`` holds, nearest their centre first."""
     pts = [q for q in GRID if inside(q)]
     cx, cy = float(np.mean([q[0] for q in pts])), float(np.mean([q[1] for q in pts]))
     return tuple(sorted(pts, key=lambda q: (q[0] - cx) ** 2 + (q[1] - cy) ** 2))
+
+
+@functools.cache  # planners ask on every step; the grid never changes
+def _region_points(region: str) -> tuple[tuple[float, float], ...]:
+    return _area_points(REGIONS[region])
 
 
 class InRegion(Relation):
@@ -964,11 +968,8 @@ PLACE_AREA = {"back-edge": lambda xy: xy[1] > -0.2 - EDGE, "front-edge": lambda 
 
 @functools.cache
 def place_points(place: str) -> tuple[tuple[float, float], ...]:
-    """Grid points of an area, nearest its centre first."""
-    inside = PLACE_AREA[place]
-    pts = [q for q in GRID if inside(q)]
-    cx, cy = float(np.mean([q[0] for q in pts])), float(np.mean([q[1] for q in pts]))
-    return tuple(sorted(pts, key=lambda q: (q[0] - cx) ** 2 + (q[1] - cy) ** 2))
+    """Grid points of a place, nearest its centre first."""
+    return _area_points(PLACE_AREA[place])
 
 
 class Placed(Structure):
