@@ -144,6 +144,18 @@ def test_every_method_is_paired_against_the_best_baseline(tmp_path):
     assert all(m not in BASELINES for m in ("bayes-stop", "lang-stop"))
 
 
+def test_every_learner_is_paired_with_the_reward_peer_of_its_signal(tmp_path):
+    methods = ["bayes-stop", "lang-stop", "reward-stop", "reward-stop-noplanner", "zero-signal"]
+    records = records_of(methods)
+    text = write_report(records, methods, ["stack", "align"], tmp_path, SETTINGS).read_text()
+    section = text.split("## Paired comparisons")[1]
+    assert "reward-learning peer of its signal (reward-stop)" in section
+    rows = [line.split(" | ")[0] for line in section.splitlines() if line.startswith("| ") and " − " in line]
+    assert "| bayes-stop − reward-stop" in rows and "| lang-stop − reward-stop" in rows
+    assert not [r for r in rows if r.startswith("| reward-stop") and "zero-signal" not in r]  # not with itself
+    assert report.peer_pairs(["bayes-preference", "reward-stop"]) == []  # only the peer of the same signal
+
+
 def test_sign_test_and_paired_bootstrap():
     assert sign_test(8, 0) == pytest.approx(2 / 2**8)
     assert sign_test(3, 3) == 1.0 and sign_test(0, 0) == 1.0

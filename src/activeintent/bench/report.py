@@ -160,6 +160,31 @@ def paired_comparison(records: list[dict], a: str, b: str) -> dict | None:
             "final_lo": lo, "final_hi": hi, "final_n": len(diffs)}
 
 
+# The field's standard peer (reward learning over state features), one per signal: every other
+# learner of that signal in the bench is paired with it.
+PEERS = {"stop": "reward-stop", "preference": "reward-preference"}
+
+
+def _signal_of(method: str) -> str | None:
+    from activeintent.learners.registry import get_method
+
+    try:
+        return get_method(method).signal
+    except Exception:  # noqa: BLE001 - a plug-in method not loaded here: its name's last word
+        tail = method.rsplit("-", 1)[-1]
+        return tail if tail in PEERS else None
+
+
+def peer_pairs(methods: list[str]) -> list[tuple[str, str]]:
+    """(learner, the reward peer of its signal) for every learner of the bench that has one."""
+    out = []
+    for m in methods:
+        peer = PEERS.get(_signal_of(m) or "")
+        if peer in methods and m != peer and m not in BASELINES and not m.startswith(peer):
+            out.append((m, peer))
+    return out
+
+
 def best_baseline(records: list[dict], methods: list[str]) -> str | None:
     """The baseline of this bench with the highest mean success@K (the bar a learner must clear)."""
     scores = {m: float(np.mean(v)) for m in methods if m in BASELINES
@@ -172,14 +197,18 @@ def paired_section(records: list[dict], methods: list[str]) -> list[str]:
     method against the best baseline, on the same trials."""
     best = best_baseline(records, methods)
     pairs = [(a, b) for a, b in PAIRED if a in methods and b in methods]
+    peers = [pair for pair in peer_pairs(methods) if pair not in pairs]
+    pairs += peers
     if best is not None:
         pairs += [(m, best) for m in methods if m not in BASELINES and (m, best) not in pairs]
     rows = [d for a, b in pairs if (d := paired_comparison(records, a, b))]
     if not rows:
         return []
     against = f" and every method against the best baseline here, **{best}** (highest mean success@K)" if best else ""
+    peer_text = (", every learner against the reward-learning peer of its signal "
+                 f"({', '.join(sorted({b for _, b in peers}))})") if peers else ""
     lines = ["", "## Paired comparisons", "",
-             f"EIG against random questions, decide against lang{against}. Each episode of the method is paired "
+             f"EIG against random questions, decide against lang{peer_text}{against}. Each episode of the method is paired "
              "with the other method's episode on the same intention and trial (same query-scene seeds, user noise "
              "and test scenes); n = pairs. Area: the mean of the episode's success@k over k = 0..K, difference "
              "with a 95 % interval from the normal approximation of the paired mean; wins / ties / losses and "
