@@ -1,8 +1,8 @@
 """Benchmark suites of hidden intentions: ``paper`` (the paper's four), ``library`` (the other
 built-in intentions), ``heldout`` (written blind, before any learner change, in
-``bench/heldout.py``; reported separately), ``heldout2`` (a second held-out suite, ``h2-…``,
+``intentions/suites/heldout.py``; reported separately), ``heldout2`` (a second held-out suite, ``h2-…``,
 written blind with the world's helpers only, in ``intentions/suites/heldout2.py``; reported
-separately, like ``heldout``), ``dev`` (``bench/dev.py``: for tuning learners) and
+separately, like ``heldout``), ``dev`` (``intentions/suites/dev.py``: for tuning learners) and
 ``truth-goals`` (``truth-00`` … ``truth-49``: 50 goals of the goal language drawn at random and
 committed as data, ``bench/truth_goals.json``; learning efficiency apart from coverage).
 Names of every suite resolve everywhere an intention name is accepted.
@@ -26,7 +26,7 @@ HELDOUT_SUITES = ("heldout", "heldout2")  # written blind; never tuned on; per i
 
 
 def _heldout() -> dict[str, Intention]:
-    from activeintent.bench.heldout import heldout_intentions
+    from activeintent.intentions.suites.heldout import heldout_intentions
 
     return {it.name: it for it in heldout_intentions()}
 
@@ -43,7 +43,7 @@ def _heldout2_names() -> frozenset[str]:
 
 
 def _dev() -> dict[str, Intention]:
-    from activeintent.bench.dev import dev_intentions
+    from activeintent.intentions.suites.dev import dev_intentions
 
     return {it.name: it for it in dev_intentions()}
 

@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from activeintent.bench.dev import dev_intentions
 from activeintent.intentions import all_intentions, get_intention
 from activeintent.intentions.placement import is_warm
+from activeintent.intentions.suites.dev import dev_intentions
 from activeintent.protocol import sample_test_scene
 from activeintent.world import (
     PutAt,

@@ -1,1 +1,2 @@
-"""Benchmark suites of hidden intentions written as modules of their own (``heldout2``, ...)."""
+"""Benchmark suites of hidden intentions written as modules of their own: ``dev`` (for developing
+learners), ``heldout`` and ``heldout2`` (written blind, never tuned on; see ``activeintent.suites``)."""

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from activeintent.bench import heldout
-from activeintent.bench.heldout import HELDOUT_INTENTIONS, heldout_intentions
 from activeintent.intentions import INTENTION_NAMES
+from activeintent.intentions.suites import heldout
+from activeintent.intentions.suites.heldout import HELDOUT_INTENTIONS, heldout_intentions
 from activeintent.world import (
     PutAt,
     PutIn,
