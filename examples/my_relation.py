@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from activeintent.learners.bayes.facts import facts
-from activeintent.learners.lang.expr import Each, Goal, Relation, region_points, register
-from activeintent.learners.lang.planner import plan, run
+from activeintent.goals.facts import facts
+from activeintent.goals.language import Each, Goal, Relation, region_points, register
+from activeintent.goals.planner import plan, run
 from activeintent.world import PutAt, Scene, WorldState, layout
 from activeintent.world.colors import COLOR_NAMES
 

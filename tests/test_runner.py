@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 from pydantic import BaseModel
 
+from activeintent.goals.language import Each, Goal
 from activeintent.learners.lang import learner as lang_learner
-from activeintent.learners.lang.expr import Each, Goal
 from activeintent.learners.lang.hypotheses import LangSpace
 from activeintent.learners.registry import METHODS, PAPER_METHODS
 from activeintent.runner import RunOptions, build_episode

@@ -10,9 +10,9 @@ import pytest
 from typer.testing import CliRunner
 
 from activeintent.bench import coverage as cov
+from activeintent.goals.facts import facts
+from activeintent.goals.language import parse_goal
 from activeintent.intentions.base import Intention
-from activeintent.learners.bayes.facts import facts
-from activeintent.learners.lang.expr import parse_goal
 from activeintent.learners.lang.hypotheses import GoalIntention
 from activeintent.world import PutAt, WorldState, apply_skill
 from activeintent.world.scene import sample_scene

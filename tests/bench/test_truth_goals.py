@@ -15,7 +15,7 @@ import pytest
 
 from activeintent.bench import truth_goals as tg
 from activeintent.bench.report import MIN_SCORED
-from activeintent.learners.lang.expr import NODES, QUANTS, Each, parse_goal
+from activeintent.goals.language import NODES, QUANTS, Each, parse_goal
 from activeintent.learners.lang.hypotheses import GoalIntention
 from activeintent.suites import SUITE_NAMES, resolve, suite, suite_of
 

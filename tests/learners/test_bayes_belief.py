@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from activeintent.envs.symbolic import symbolic_trajectory
+from activeintent.goals.facts import facts
 from activeintent.learners.bayes.acquisition import eig, select_query, with_new_scene
 from activeintent.learners.bayes.belief import Belief, log_prior
 from activeintent.learners.bayes.candidates import candidate_plans
-from activeintent.learners.bayes.facts import facts
 from activeintent.learners.bayes.hypotheses import hypothesis_space
 from activeintent.learners.bayes.judge import HypothesisJudge
 from activeintent.signals import get_signal

@@ -52,9 +52,10 @@ def _closure(start: Path) -> set[Path]:
 def _dependencies() -> set[Path]:
     """What the cached names are computed from: the grammar modules and all they import."""
     bayes = Path(hyp.__file__).resolve().parent
+    goals = bayes.parents[1] / "goals"
     out: set[Path] = set()
-    for name in ("hypotheses.py", "behaviours.py", "facts.py", "planning.py"):
-        out |= _closure(bayes / name)
+    for path in (bayes / "hypotheses.py", bayes / "behaviours.py", goals / "facts.py", goals / "planning.py"):
+        out |= _closure(path)
     return out
 
 
@@ -65,7 +66,7 @@ def test_key_covers_every_module_the_grammar_imports():
     assert {"world/state.py", "intentions/base.py"} <= names
     deps = _dependencies()
     # sanity of the import walk: it reaches the world model through the grammar
-    assert {"world/state.py", "world/predict.py", "bayes/facts.py"} <= {f"{p.parent.name}/{p.name}" for p in deps}
+    assert {"world/state.py", "world/predict.py", "goals/facts.py"} <= {f"{p.parent.name}/{p.name}" for p in deps}
     missing = sorted(str(p) for p in deps - sources)
     assert not missing, f"the hypothesis cache key ignores {missing}"
 

@@ -10,9 +10,9 @@ import pytest
 from pydantic import ValidationError
 
 from activeintent.envs.symbolic import symbolic_trajectory
+from activeintent.goals.facts import facts
 from activeintent.learners.base import RoundRecord
 from activeintent.learners.bayes import proposals
-from activeintent.learners.bayes.facts import facts
 from activeintent.learners.bayes.judge import HypothesisJudge
 from activeintent.learners.bayes.learner import BayesConfig, BayesLearner
 from activeintent.learners.bayes.proposals import (

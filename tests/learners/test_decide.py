@@ -9,6 +9,7 @@ import pytest
 from activeintent.act.base import make_executor
 from activeintent.envs.symbolic import SymbolicEnv
 from activeintent.episode import Episode, EpisodeConfig
+from activeintent.goals.language import parse_goal
 from activeintent.learners.bayes.acquisition import select_query
 from activeintent.learners.bayes.candidates import Outcome
 from activeintent.learners.bayes.decision import (
@@ -16,7 +17,6 @@ from activeintent.learners.bayes.decision import (
     decision_classes,
     deployment_states,
 )
-from activeintent.learners.lang.expr import parse_goal
 from activeintent.learners.lang.hypotheses import LangSpace
 from activeintent.learners.lang.learner import DECIDE, LangConfig, LangLearner
 from activeintent.learners.registry import LearnerContext, get_method

@@ -8,10 +8,10 @@ import pytest
 from activeintent.act.base import make_executor
 from activeintent.envs.symbolic import SymbolicEnv
 from activeintent.episode import Episode, EpisodeConfig
-from activeintent.learners.bayes.facts import facts
+from activeintent.goals import planner
+from activeintent.goals.facts import facts
+from activeintent.goals.language import NODES, Each, Form, Goal, all_clauses, parse_goal
 from activeintent.learners.bayes.hypotheses import random_scene
-from activeintent.learners.lang import planner
-from activeintent.learners.lang.expr import NODES, Each, Form, Goal, all_clauses, parse_goal
 from activeintent.learners.lang.hypotheses import GoalIntention, LangSpace
 from activeintent.learners.lang.learner import LangLearner
 from activeintent.learners.lang.space import Compiled

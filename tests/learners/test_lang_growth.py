@@ -10,8 +10,8 @@ import pytest
 from activeintent.act.base import make_executor
 from activeintent.envs.symbolic import SymbolicEnv
 from activeintent.episode import Episode, EpisodeConfig
+from activeintent.goals.language import MAX_CLAUSES, Each, Goal, parse_goal
 from activeintent.learners.bayes.belief import Belief
-from activeintent.learners.lang.expr import MAX_CLAUSES, Each, Goal, parse_goal
 from activeintent.learners.lang.hypotheses import GoalIntention, LangSpace
 from activeintent.learners.lang.learner import LangConfig, LangJudge, LangLearner
 from activeintent.learners.lang.proposals import goals_schema, neighbours, to_goal

@@ -36,10 +36,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from activeintent.goals.facts import facts
+from activeintent.goals.language import Goal, all_clauses, parse_goal
+from activeintent.goals.planner import generic_moves, plan
 from activeintent.intentions.base import Intention
-from activeintent.learners.bayes.facts import facts
-from activeintent.learners.lang.expr import Goal, all_clauses, parse_goal
-from activeintent.learners.lang.planner import generic_moves, plan
 from activeintent.learners.lang.space import Compiled
 from activeintent.protocol import sample_test_scene, stable_seed
 from activeintent.suites import HELDOUT_SUITES

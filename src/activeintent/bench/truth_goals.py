@@ -1,5 +1,5 @@
 """The truth-goal suite (``--suite truth-goals``): 50 hidden intentions that are goals of the
-goal language itself (``learners/lang/expr.py``), so the ``lang-*`` learners can represent
+goal language itself (``goals/language.py``), so the ``lang-*`` learners can represent
 every one of them exactly. It measures learning efficiency alone, how quickly a learner finds a
 goal it can express, apart from coverage (what the blind held-out suite measures).
 
@@ -58,8 +58,8 @@ from pathlib import Path
 import numpy as np
 
 from activeintent.episode import EpisodeSeeds
-from activeintent.learners.bayes.facts import facts
-from activeintent.learners.lang.expr import (
+from activeintent.goals.facts import facts
+from activeintent.goals.language import (
     MAX_CLAUSES,
     NODES,
     QUANTS,

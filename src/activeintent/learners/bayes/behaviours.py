@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from itertools import combinations
 
-from activeintent.learners.bayes.facts import ALIGN_TOL, Facts, facts
-from activeintent.learners.bayes.planning import (
+from activeintent.goals.facts import ALIGN_TOL, Facts, facts
+from activeintent.goals.planning import (
     HALVES,
     in_region,
     nearest_points,

@@ -13,7 +13,7 @@ import numpy as np
 
 from activeintent import ranking
 from activeintent.envs.symbolic import symbolic_trajectory
-from activeintent.learners.bayes.facts import facts, state_key
+from activeintent.goals.facts import facts, state_key
 from activeintent.learners.bayes.hypotheses import Hypothesis
 from activeintent.world import Skill, WorldState
 from activeintent.world.trajectory import Trajectory

@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from activeintent.goals.facts import facts
 from activeintent.learners.bayes.candidates import candidate_plans
-from activeintent.learners.bayes.facts import facts
 from activeintent.protocol import sample_test_scene
 from activeintent.world import Scene, WorldState, layout
 

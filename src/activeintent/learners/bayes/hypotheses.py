@@ -25,10 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
+from activeintent.goals.facts import Facts, facts, is_cool, is_warm
+from activeintent.goals.planning import HALVES, run
 from activeintent.intentions.base import Intention
 from activeintent.learners.bayes import behaviours as bh
-from activeintent.learners.bayes.facts import Facts, facts, is_cool, is_warm
-from activeintent.learners.bayes.planning import HALVES, run
 from activeintent.world import COLOR_NAMES, Scene, Skill, WorldState, layout, sample_scene
 from activeintent.world.skills import TABLE_POSITIONS
 
@@ -272,11 +272,12 @@ def _bank(seed: int, others: int) -> list[tuple[Scene, list[Facts]]]:
 
 
 def _cache_sources() -> list[Path]:
-    """Every source file the cached result depends on: the grammar, all of world/, intentions/."""
+    """Every source file the cached result depends on: the grammar, the facts and placing helpers
+    it is built on, all of world/, intentions/."""
     pkg = Path(__file__).resolve().parents[2]
-    grammar = ("hypotheses.py", "behaviours.py", "facts.py", "planning.py")
-    bayes = [pkg / "learners" / "bayes" / name for name in grammar]
-    return bayes + sorted((pkg / "world").glob("*.py")) + sorted((pkg / "intentions").glob("*.py"))
+    bayes = [pkg / "learners" / "bayes" / name for name in ("hypotheses.py", "behaviours.py")]
+    goals = [pkg / "goals" / name for name in ("facts.py", "planning.py")]
+    return bayes + goals + sorted((pkg / "world").glob("*.py")) + sorted((pkg / "intentions").glob("*.py"))
 
 
 def _cache_file(seed: int, others: int, sources: list[Path] | None = None) -> Path:

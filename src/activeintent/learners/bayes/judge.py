@@ -6,7 +6,7 @@ import itertools
 
 import numpy as np
 
-from activeintent.learners.bayes.facts import Facts, facts
+from activeintent.goals.facts import Facts, facts
 from activeintent.learners.bayes.hypotheses import Hypothesis
 from activeintent.world import WorldState
 from activeintent.world.trajectory import Trajectory

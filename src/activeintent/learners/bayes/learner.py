@@ -25,12 +25,12 @@ import numpy as np
 from pydantic import BaseModel, Field
 
 from activeintent import ranking
+from activeintent.goals.facts import facts
 from activeintent.learners.base import Estimate, Learner, RoundRecord
 from activeintent.learners.bayes.acquisition import Query, particles, select_query
 from activeintent.learners.bayes.belief import Belief, Prior
 from activeintent.learners.bayes.candidates import candidate_plans, chained_plans, predict
 from activeintent.learners.bayes.decision import decision_classes, deployment_states
-from activeintent.learners.bayes.facts import facts
 from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space, random_scene
 from activeintent.learners.bayes.judge import HypothesisJudge
 from activeintent.learners.bayes.needs import Needs, p_answered, p_new_scene

@@ -16,7 +16,7 @@ from typing import Protocol
 import numpy as np
 from pydantic import BaseModel, Field, field_validator
 
-from activeintent.learners.bayes.facts import Facts, facts
+from activeintent.goals.facts import Facts, facts
 from activeintent.learners.bayes.hypotheses import Hypothesis
 from activeintent.llm.base import ChatModel, Message
 from activeintent.world import WorldState

@@ -1,7 +1,6 @@
 """An open-ended active learner: a goal language, one generic planner, a large belief.
 
-- expr.py — the language (node types in a registry, clauses, goals, description length);
-- planner.py — one planner for every goal, on the symbolic world model;
+- the language and its planner are the package ``activeintent.goals``;
 - space.py — enumeration, behavioural de-duplication on probe scenes, a vectorised judge;
 - hypotheses.py — goals as hypotheses of the Bayesian learner and as hidden intentions;
 - proposals.py — new goals while learning: neighbours of likely goals, a model's goals;

@@ -16,7 +16,7 @@ import re
 from collections import Counter
 from functools import lru_cache
 
-from activeintent.learners.lang.expr import NODES, Goal, all_clauses
+from activeintent.goals.language import NODES, Goal, all_clauses
 
 MIN_SCORE = 0.45
 STOP = {"the", "a", "an", "is", "are", "be", "should", "to", "of", "on", "in", "and", "it", "its", "their",

@@ -18,11 +18,11 @@ from collections import OrderedDict
 
 import numpy as np
 
+from activeintent.goals import planner
+from activeintent.goals.facts import Facts, facts
+from activeintent.goals.language import Goal
 from activeintent.intentions.base import Intention
-from activeintent.learners.bayes.facts import Facts, facts
 from activeintent.learners.bayes.hypotheses import Hypothesis, random_scene
-from activeintent.learners.lang import planner
-from activeintent.learners.lang.expr import Goal
 from activeintent.learners.lang.space import Compiled, goal_space
 from activeintent.world import Scene, Skill, WorldState
 

@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
+from activeintent.goals.facts import Facts, facts
 from activeintent.learners.base import RoundRecord
-from activeintent.learners.bayes.facts import Facts, facts
 from activeintent.learners.bayes.judge import HypothesisJudge, trajectory_steps, utility
 from activeintent.learners.bayes.learner import BayesConfig, BayesLearner
 from activeintent.learners.lang.hypotheses import LangHypothesis, LangSpace, lang_space

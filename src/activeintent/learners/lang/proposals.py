@@ -24,7 +24,7 @@ from typing import Literal
 
 from pydantic import BaseModel, Field, create_model
 
-from activeintent.learners.lang.expr import MAX_CLAUSES, NODES, QUANTS, Each, Form, Goal
+from activeintent.goals.language import MAX_CLAUSES, NODES, QUANTS, Each, Form, Goal
 from activeintent.llm.base import ChatModel, Message
 
 

@@ -25,10 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
-from activeintent.learners.bayes.facts import Facts, facts
+from activeintent.goals.facts import Facts, facts
+from activeintent.goals.language import NODES, QUANTS, Each, Form, Goal, all_clauses, parse_goal
+from activeintent.goals.planner import generic_moves, plan
 from activeintent.learners.bayes.hypotheses import random_scene
-from activeintent.learners.lang.expr import NODES, QUANTS, Each, Form, Goal, all_clauses, parse_goal
-from activeintent.learners.lang.planner import generic_moves, plan
 from activeintent.world import WorldState, apply_skill, layout
 from activeintent.world.scene import kind_of
 
@@ -296,9 +296,9 @@ def probe_bank(seed: int = 0, n_scenes: int = 40, walks: int = 3, planned: int =
 
 def _sources() -> list[Path]:
     pkg = Path(__file__).resolve().parents[2]
-    lang = [pkg / "learners" / "lang" / n for n in ("expr.py", "planner.py", "space.py")]
-    bayes = [pkg / "learners" / "bayes" / n for n in ("facts.py", "planning.py", "hypotheses.py")]
-    return lang + bayes + sorted((pkg / "world").glob("*.py"))
+    goals = sorted((pkg / "goals").glob("*.py"))
+    lang = [pkg / "learners" / "lang" / "space.py", pkg / "learners" / "bayes" / "hypotheses.py"]
+    return goals + lang + sorted((pkg / "world").glob("*.py"))
 
 
 def cache_path(tag: str) -> Path:

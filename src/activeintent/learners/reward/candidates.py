@@ -17,8 +17,8 @@ import numpy as np
 
 from activeintent import ranking
 from activeintent.envs.symbolic import symbolic_trajectory
+from activeintent.goals.facts import facts, state_key
 from activeintent.learners.bayes.candidates import Outcome
-from activeintent.learners.bayes.facts import facts, state_key
 from activeintent.learners.reward.features import phi
 from activeintent.world import PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState, apply_skill
 from activeintent.world.skills import TABLE_POSITIONS

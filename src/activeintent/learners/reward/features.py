@@ -21,7 +21,7 @@ import functools
 
 import numpy as np
 
-from activeintent.learners.bayes.facts import ALIGN_TOL, Facts, facts
+from activeintent.goals.facts import ALIGN_TOL, Facts, facts
 from activeintent.world import WorldState
 from activeintent.world.colors import COLOR_NAMES, COOL_COLORS, WARM_COLORS
 from activeintent.world.relations import _GRID

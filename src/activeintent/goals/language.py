@@ -19,7 +19,7 @@ Selectors depend only on the scene (colours of the blocks and of the bowls prese
 positions, so the group of a clause is fixed for a scene. A relation that names a block
 ("next to the red block") leaves that block out of the group.
 
-Everything judges :class:`~activeintent.learners.bayes.facts.Facts` (relations of one state,
+Everything judges :class:`~activeintent.goals.facts.Facts` (relations of one state,
 computed once and shared by all expressions).
 """
 
@@ -33,8 +33,8 @@ from itertools import combinations, permutations
 
 import numpy as np
 
-from activeintent.learners.bayes.facts import ALIGN_TOL, Facts, facts
-from activeintent.learners.bayes.planning import GRID
+from activeintent.goals.facts import ALIGN_TOL, Facts, facts
+from activeintent.goals.planning import GRID
 from activeintent.world import BLOCK_SIZE, PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState
 from activeintent.world.colors import COLOR_NAMES, COOL_COLORS, WARM_COLORS
 from activeintent.world.relations import table_position_name

@@ -22,8 +22,8 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from activeintent.learners.bayes.facts import Facts, facts
-from activeintent.learners.lang.expr import REGIONS, Goal, region_points
+from activeintent.goals.facts import Facts, facts
+from activeintent.goals.language import REGIONS, Goal, region_points
 from activeintent.world import (
     PutAt,
     PutIn,

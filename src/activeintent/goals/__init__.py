@@ -1,0 +1,11 @@
+"""The vocabulary of goals, shared by the learners that reason about goals.
+
+- facts.py — the relational facts of a world state (in a bowl, on a block, next to, regions, …);
+- language.py — the goal language: selectors, relations and structures in a registry, clauses,
+  goals z, their sentences and description length L(z);
+- planner.py — one planner for every goal of the language, on the symbolic world model;
+- planning.py — placing helpers (free grid points, regions) the planners share.
+
+Held-out suites never import this package: they are written with the world's helpers only, so
+that whether the language can say them is measured, not true by construction.
+"""
