@@ -37,13 +37,18 @@ def in_region(region: str, xy: tuple[float, float]) -> bool:
 
 
 def region_points(region: str, step: float = GRID_STEP) -> list[tuple[float, float]]:
-    """Grid points of ``region``, nearest its centre first."""
+    """Grid points of ``region``, nearest its centre first (a new list: callers may extend it)."""
+    return list(_region_points(region, step))
+
+
+@lru_cache(maxsize=256)  # a pure function of a fixed grid, asked for on every planning step
+def _region_points(region: str, step: float) -> tuple[tuple[float, float], ...]:
     pts = [p for p in (GRID if step == GRID_STEP else _fine_grid(step)) if in_region(region, p)]
     if not pts:
-        return []
+        return ()
     cx = float(np.mean([p[0] for p in pts]))
     cy = float(np.mean([p[1] for p in pts]))
-    return sorted(pts, key=lambda p: (p[0] - cx) ** 2 + (p[1] - cy) ** 2)
+    return tuple(sorted(pts, key=lambda p: (p[0] - cx) ** 2 + (p[1] - cy) ** 2))
 
 
 @lru_cache(maxsize=4)

@@ -14,6 +14,71 @@ from activeintent.world.trajectory import Trajectory
 _TOKENS = itertools.count()
 
 
+class _Clauses:
+    """The grammar hypotheses of a tuple as indices into their distinct clauses, so that a state
+    is judged once per clause and combined in numpy (the same arithmetic, in the same order, as
+    :meth:`Hypothesis.holds_f` / ``score_f`` / ``moved_off``). Hypotheses that judge by their own
+    methods (model-proposed ones) are asked one by one, as before."""
+
+    def __init__(self, hyps: tuple[Hypothesis, ...]):
+        grammar = [i for i, h in enumerate(hyps) if _judged_by_clauses(h)]
+        self.grammar = np.array(grammar, dtype=int)
+        self.own = [i for i in range(len(hyps)) if not _judged_by_clauses(hyps[i])]
+        index: dict[tuple[str, str], int] = {}
+        self.clauses = []
+        width = max((len(hyps[i].clauses) for i in grammar), default=0)
+        self.idx = np.full((len(grammar), width), -1, dtype=int)  # -1: no clause (a pad entry)
+        for row, i in enumerate(grammar):
+            for j, c in enumerate(hyps[i].clauses):
+                key = (c.selector, c.behaviour.key)  # judge_f's memo key: one verdict per key
+                if key not in index:
+                    index[key] = len(self.clauses)
+                    self.clauses.append(c)
+                self.idx[row, j] = index[key]
+
+    def judge(self, f: Facts) -> tuple[np.ndarray, np.ndarray]:
+        """(satisfied, score) of the grammar hypotheses, in the order of ``grammar``."""
+        verdicts = [c.judge_f(f) for c in self.clauses] + [(True, 0.0, 0)]  # the pad last
+        holds = np.array([v[0] for v in verdicts], dtype=bool)
+        score = np.array([v[1] for v in verdicts], dtype=float)
+        size = np.array([v[2] for v in verdicts], dtype=int)
+        sat = holds[self.idx].all(axis=1)
+        total = np.zeros(len(self.idx))
+        for j in range(self.idx.shape[1]):  # clause by clause: the float sums of score_f
+            total = total + score[self.idx[:, j]] * size[self.idx[:, j]]
+        n = size[self.idx].sum(axis=1)
+        return sat, np.where(n > 0, total / np.maximum(n, 1), 1.0)
+
+    def moved_off(self, fb: Facts, fa: Facts, block: str, rows: np.ndarray) -> np.ndarray:
+        """Per grammar hypothesis in ``rows``: did moving ``block`` leave a place z allows?"""
+        off = np.zeros(len(self.clauses) + 1, dtype=bool)
+        for ci in np.unique(self.idx[rows]):
+            if ci < 0:
+                continue
+            c = self.clauses[ci]
+            g = c.group_f(fa)
+            off[ci] = block in g and not c.behaviour.moved_ok(fb, fa, g, block)
+        return off[self.idx[rows]].any(axis=1)
+
+
+def _judged_by_clauses(h: Hypothesis) -> bool:
+    t = type(h)
+    return (t.holds_f is Hypothesis.holds_f and t.score_f is Hypothesis.score_f
+            and t.moved_off is Hypothesis.moved_off and bool(h.clauses))
+
+
+_COMPILED: dict[object, _Clauses] = {}
+
+
+def _compiled(hyps: tuple[Hypothesis, ...], token: object) -> _Clauses:
+    got = _COMPILED.get(token)
+    if got is None:
+        if len(_COMPILED) > 64:
+            _COMPILED.clear()
+        got = _COMPILED[token] = _Clauses(hyps)
+    return got
+
+
 def judge(hyps: tuple[Hypothesis, ...], f: Facts, token: object = None) -> tuple[np.ndarray, np.ndarray]:
     """(satisfied, score) of one state under every hypothesis, memoised on the facts under
     ``token`` (unique per judge: an id() could be reused by a later tuple)."""
@@ -22,8 +87,12 @@ def judge(hyps: tuple[Hypothesis, ...], f: Facts, token: object = None) -> tuple
     key = ("judge", token)
     got = f.memo.get(key)
     if got is None:
-        sat = np.fromiter((h.holds_f(f) for h in hyps), bool, len(hyps))
-        score = np.fromiter((h.score_f(f) for h in hyps), float, len(hyps))
+        comp = _compiled(hyps, token)
+        sat = np.zeros(len(hyps), dtype=bool)
+        score = np.zeros(len(hyps), dtype=float)
+        sat[comp.grammar], score[comp.grammar] = comp.judge(f)
+        for i in comp.own:
+            sat[i], score[i] = hyps[i].holds_f(f), hyps[i].score_f(f)
         got = f.memo[key] = (sat, score)
     return got
 
@@ -44,19 +113,26 @@ def trajectory_steps(traj: Trajectory) -> Steps:
 def first_away(hyps: tuple[Hypothesis, ...], steps: Steps, token: object = None) -> np.ndarray:
     """Per hypothesis, the index of the first step that moves away from it (-1: none).
     A failed step counts only when it made things worse (its score dropped)."""
+    if token is None:
+        token = tuple(h.name for h in hyps)
+    comp = _compiled(hyps, token)
     out = np.full(len(hyps), -1)
     for k, (fb, fa, block, ok) in enumerate(steps):
-        todo = np.flatnonzero(out < 0)
-        if not len(todo):
+        todo = out < 0
+        if not todo.any():
             break
         if fb is fa:
             continue
         _, sb = judge(hyps, fb, token)
         _, sa = judge(hyps, fa, token)
-        drop = sa < sb - 1e-9
-        for i in todo:
-            if drop[i] or (ok and hyps[i].moved_off(fb, fa, block)):
-                out[i] = k
+        away = sa < sb - 1e-9
+        if ok:
+            rows = np.flatnonzero(todo[comp.grammar] & ~away[comp.grammar])
+            away[comp.grammar[rows]] = comp.moved_off(fb, fa, block, rows)
+            for i in comp.own:
+                if todo[i] and not away[i]:
+                    away[i] = hyps[i].moved_off(fb, fa, block)
+        out[todo & away] = k
     return out
 
 
