@@ -104,8 +104,9 @@ def test_compiled_judge_matches_the_goals():
                 fa = facts(new)
                 holds, score = comp.eval(fa)
                 off = comp.moved_off(f0, fa, step.block)
-                for i, group, _shape, _key in comp._form_cases(fa):  # the vectorised groups = Form's own
-                    assert group == comp.clauses[i].group_f(fa), comp.clauses[i].key
+                groups, gid, _ = comp._form_keys(fa)  # the vectorised groups = Form's own
+                for i, g_i in zip(comp.forms, gid.tolist(), strict=True):
+                    assert groups[g_i] == comp.clauses[i].group_f(fa), comp.clauses[i].key
                 for i, g in enumerate(goals):
                     assert holds[i] == g.holds(fa), g.key
                     assert score[i] == pytest.approx(g.score(fa)), g.key

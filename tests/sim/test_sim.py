@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import imageio.v2 as iio
 import numpy as np
 import pytest
@@ -348,3 +350,15 @@ def test_a_pool_that_cannot_start_is_tried_once(demo, tmp_path):
         "    print(first, r.warm_render_pool(2), len(frames) == len(frame_times(demo, 4)), len(tries))\n")
     got = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300, cwd=tmp_path)
     assert got.stdout.split() == ["False", "False", "True", "1"], got.stdout + got.stderr[-2000:]
+
+
+def test_light_panda_is_written_once_for_every_process():
+    """The light Panda's file name comes from its text, not from a per-process salted hash()
+    (else every benchmark process leaves one more copy in the cache)."""
+    import subprocess
+    import sys
+
+    code = "from activeintent.sim.assets import light_panda_urdf; print(light_panda_urdf())"
+    paths = {subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                            env={**os.environ, "PYTHONHASHSEED": seed}).stdout.strip() for seed in ("1", "2")}
+    assert len(paths) == 1

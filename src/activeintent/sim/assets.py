@@ -146,6 +146,7 @@ def light_panda_urdf() -> str:
     several times slower; the collision meshes keep the arm's shape at a fraction of that.
     Written once to a cache directory (~/.cache/activeintent, or the temp dir).
     """
+    import hashlib
     import os
     import tempfile
     from pathlib import Path
@@ -159,7 +160,7 @@ def light_panda_urdf() -> str:
     for base in (Path.home() / ".cache" / "activeintent", Path(tempfile.gettempdir()) / "activeintent"):
         try:
             base.mkdir(parents=True, exist_ok=True)
-            path = base / f"panda_light_{abs(hash(text)) % 10**8}.urdf"
+            path = base / f"panda_light_{hashlib.sha256(text.encode()).hexdigest()[:16]}.urdf"  # hash() is salted per process
             if not path.exists() or path.read_text() != text:
                 tmp = base / f".{path.name}.{os.getpid()}"
                 tmp.write_text(text)

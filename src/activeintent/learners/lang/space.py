@@ -79,6 +79,9 @@ class Compiled:
             shapes.setdefault((clauses[i].struct, clauses[i].stp), len(shapes))
         self.shapes = [(NODES["structure"][st], stp) for st, stp in shapes]
         self.f_shape = [shapes[(clauses[i].struct, clauses[i].stp)] for i in self.forms]
+        self._f_index = np.array(self.forms, int)
+        self._f_sel = np.array(self.f_sel, int)
+        self._f_shape = np.array(self.f_shape, int)
         self._possible: dict[tuple[str, ...], np.ndarray] = {}
         self._tag = ("lang", next(_TOKENS))  # unique per judge (an id() can be reused)
 
@@ -153,27 +156,31 @@ class Compiled:
             got = f.memo[key] = (groups, sel_gid)
         return got
 
-    def _form_cases(self, f: Facts):
-        """Per structure clause: its index, its group in ``f``, its shape (structure, parameter)
-        and a key shared by the clauses of the same shape and group (asked once per key)."""
-        groups, sel_gid = self._form_groups(f)
-        n_groups = len(groups)
-        for i, si, sh in zip(self.forms, self.f_sel, self.f_shape, strict=True):
-            g_i = sel_gid[si]
-            yield i, groups[g_i], self.shapes[sh], sh * n_groups + g_i
+    def _form_keys(self, f: Facts) -> tuple[list[tuple[str, ...]], np.ndarray, np.ndarray]:
+        """The groups of ``f``, per structure clause its group's index, and its (shape, group)
+        key: clauses of the same shape whose selectors pick the same blocks share a verdict."""
+        key = self._tag + ("keys",)
+        got = f.memo.get(key)
+        if got is None:
+            groups, sel_gid = self._form_groups(f)
+            gid = np.asarray(sel_gid, int)[self._f_sel]
+            got = f.memo[key] = (groups, gid, self._f_shape * len(groups) + gid)
+        return got
 
     def _judge_forms(self, f: Facts, holds: np.ndarray, score: np.ndarray) -> None:
-        """Every structure clause, each (shape, group) judged once: clauses whose selectors pick
-        the same blocks share the verdict (as Form.judge, without its per-clause lookups)."""
-        done: dict[int, tuple[bool, float]] = {}
-        for i, g, (struct, stp), k in self._form_cases(f):
-            if not g:  # an empty group: holds, score 1
-                score[i] = 1.0
-                continue
-            got = done.get(k)
-            if got is None:
-                got = done[k] = struct.judge(f, g, stp)
-            holds[i], score[i] = got
+        """Every structure clause, each (shape, group) judged once (as Form.judge, without its
+        per-clause lookups); an empty group holds with score 1."""
+        groups, _, keys = self._form_keys(f)
+        uniq, inverse = np.unique(keys, return_inverse=True)
+        h = np.ones(len(uniq), bool)
+        sc = np.ones(len(uniq))
+        for u, k in enumerate(uniq.tolist()):
+            g = groups[k % len(groups)]
+            if g:
+                struct, stp = self.shapes[k // len(groups)]
+                h[u], sc[u] = struct.judge(f, g, stp)
+        holds[self._f_index] = h[inverse]
+        score[self._f_index] = sc[inverse]
 
     def eval(self, f: Facts) -> tuple[np.ndarray, np.ndarray]:
         """(holds, score) per goal."""
@@ -211,16 +218,18 @@ class Compiled:
         return off, inside
 
     def _moved_forms(self, fb: Facts, fa: Facts, b: str, off: np.ndarray, inside: np.ndarray) -> None:
-        """As Form.moved_off for every structure clause, each (shape, group) asked once."""
-        done: dict[int, bool] = {}
-        for i, g, (struct, stp), k in self._form_cases(fa):
-            if b not in g:
-                continue
-            inside[i] = True
-            got = done.get(k)
-            if got is None:
-                got = done[k] = not struct.moved_ok(fb, fa, g, b, stp)
-            off[i] = got
+        """As Form.moved_off for every structure clause whose group holds ``b``, each (shape,
+        group) asked once."""
+        groups, gid, keys = self._form_keys(fa)
+        has_b = np.array([b in g for g in groups], bool)[gid]
+        rows = np.flatnonzero(has_b)
+        if not len(rows):
+            return
+        uniq, inverse = np.unique(keys[rows], return_inverse=True)
+        went_off = np.array([not self.shapes[k // len(groups)][0].moved_ok(
+            fb, fa, groups[k % len(groups)], b, self.shapes[k // len(groups)][1]) for k in uniq.tolist()], bool)
+        inside[self._f_index[rows]] = True
+        off[self._f_index[rows]] = went_off[inverse]
 
     def moved_off(self, fb: Facts, fa: Facts, b: str) -> np.ndarray:
         key = self._tag + ("om", b)
