@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import sys
 
 import imageio.v2 as iio
 import numpy as np
@@ -242,6 +243,27 @@ def test_frames_drawn_in_worker_processes_are_the_same(demo):
     there = list(render_frames(demo, times, (96, 72), workers=2))
     assert len(here) == len(there) == len(times) > 8  # more than one chunk
     assert all(np.array_equal(a, b) for a, b in zip(here, there, strict=True))
+
+
+def test_frames_drawn_in_this_process_by_two_threads_are_each_their_own(demo):
+    """Two sessions drawing the same scene in this process (no render processes) share one
+    PyBullet client: each frame must still show its own pose, never the other thread's."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from activeintent.sim.render import render_frames
+
+    times = frame_times(demo, 30)
+    ahead, behind = times, times[::-1]  # the same scene, different poses at every moment
+    alone = [list(render_frames(demo, t, (48, 36), workers=1)) for t in (ahead, behind)]
+    switch = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)  # threads take turns between any two PyBullet calls
+    try:
+        with ThreadPoolExecutor(2) as pool:
+            together = list(pool.map(lambda t: list(render_frames(demo, t, (48, 36), workers=1)), (ahead, behind)))
+    finally:
+        sys.setswitchinterval(switch)
+    for one, other in zip(alone, together, strict=True):
+        assert all(np.array_equal(a, b) for a, b in zip(one, other, strict=True))
 
 
 def test_render_state(demo):

@@ -12,6 +12,7 @@ z-buffer over both would keep, at a third of the time.
 
 from __future__ import annotations
 
+import threading
 from collections import OrderedDict
 
 import numpy as np
@@ -134,6 +135,7 @@ class SceneRenderer:
 
 
 _cache: OrderedDict[tuple[str, ...], SceneRenderer] = OrderedDict()
+_HERE = threading.Lock()  # this process's PyBullet clients draw for one thread at a time
 
 
 def renderer_for(object_names: list[str]) -> SceneRenderer:
@@ -165,7 +167,8 @@ def render_state(state: WorldState, size: tuple[int, int] = (240, 240)) -> np.nd
     size = _check_size(size)
     names = state.names
     poses = np.array([[*state.positions[n], 0.0, 0.0, 0.0, 1.0] for n in names])
-    return renderer_for(names).draw(poses, None, size)
+    with _HERE:
+        return renderer_for(names).draw(poses, None, size)
 
 
 # -- frames of a video in worker processes ---------------------------------------------------
@@ -243,9 +246,10 @@ def warm_render_pool(workers: int) -> bool:
 
 
 def _draw_here(traj: Trajectory, ticks: list[int], size: tuple[int, int]):
-    renderer = renderer_for(traj.object_names)
     for k in ticks:
-        yield renderer.draw(traj.object_poses[k], traj.joint_positions[k], size)
+        with _HERE:
+            frame = renderer_for(traj.object_names).draw(traj.object_poses[k], traj.joint_positions[k], size)
+        yield frame
 
 
 def render_frames(traj: Trajectory, times: np.ndarray, size: tuple[int, int] = (240, 240),
