@@ -14,7 +14,9 @@
 - ``decide-needs-scenes-<signal>`` (a variant, not an ablation): each candidate scene also meets a
   requirement drawn from the needs belief;
 - ``decide-chains-stop`` (a variant): stop queries may also show one likely goal's plan followed by
-  another's (``BayesConfig.chains = 4``).
+  another's (``BayesConfig.chains = 4``);
+- ``decide-joint-<signal>`` (a variant): the final answer may also run a plan for both goals of a
+  pair of the 4 likeliest goals (``LangConfig.final_joint = 4``).
 """
 
 from activeintent.learners.lang.learner import DECIDE, LangConfig, LangLearner
@@ -28,8 +30,9 @@ ABLATIONS = {
     "shown-decision-gain": {"gain": "shown-decision"},
     "needs-scenes": {"scenes": "needs"},
     "chains": {"chains": 4},
+    "joint": {"final_joint": 4},
 }
-VARIANTS = ("needs-scenes", "chains")
+VARIANTS = ("needs-scenes", "chains", "joint")
 
 
 def _ablation(part: str, signal: str) -> Method:

@@ -332,9 +332,7 @@ class BayesLearner(Learner):
         feasible = self.judge.feasible(scene.objects)
         w = self.weights * feasible
         w = w / w.sum() if w.sum() > 0 else self.weights
-        outs = [predict(state, [])] + candidate_plans(
-            self.hyps, w, state, self.rng, top_k=self.config.final_top_k, explore=0,
-            prefixes=False, limit=self.config.max_plans, feasible=feasible)
+        outs = self._final_outcomes(state, w, feasible)
         finals = [facts(o.traj.outcome) for o in outs]
         self.judge.prefetch(finals)
         success = np.array([float(w @ self.judge.judge(f)[0]) for f in finals])
@@ -343,6 +341,12 @@ class BayesLearner(Learner):
         plan = outs[best].plan
         return Estimate(z=top.description, goals=[describe_plan(plan)], plans=[plan], done=True,
                         why={"expected_success": round(float(success[best]), 4)})
+
+    def _final_outcomes(self, state: WorldState, w: np.ndarray, feasible: np.ndarray) -> list:
+        """What the final answer chooses among: doing nothing and the likely z's plans."""
+        return [predict(state, [])] + candidate_plans(
+            self.hyps, w, state, self.rng, top_k=self.config.final_top_k, explore=0,
+            prefixes=False, limit=self.config.max_plans, feasible=feasible)
 
     # ---- open-ended hypotheses ----
 

@@ -9,11 +9,17 @@ their prior 2^-L(z) and their likelihood on every answer so far.
 
 from __future__ import annotations
 
+from itertools import combinations
+
 import numpy as np
 from pydantic import Field
 
+from activeintent import ranking
+from activeintent.goals import planner
 from activeintent.goals.facts import Facts, facts
+from activeintent.goals.language import Goal
 from activeintent.learners.base import RoundRecord
+from activeintent.learners.bayes.candidates import predict
 from activeintent.learners.bayes.judge import HypothesisJudge, trajectory_steps, utility
 from activeintent.learners.bayes.learner import BayesConfig, BayesLearner
 from activeintent.learners.lang.hypotheses import LangHypothesis, LangSpace, lang_space
@@ -82,6 +88,8 @@ class LangConfig(BayesConfig):
     join_partners: int = Field(32, ge=0, description="... and each of them joined with each of this many likely goals")
     max_added: int = Field(20000, ge=0, description="goals added in one episode at most")
     proposals_per_call: int = Field(3, ge=1, le=5, description="goals asked of the model per call")
+    final_joint: int = Field(0, ge=0, le=8, description="the final answer may also run a plan for both "
+                             "goals of any pair of this many likely goals (0: off): one plan can satisfy two z")
 
 
 class LangLearner(BayesLearner):
@@ -165,6 +173,25 @@ class LangLearner(BayesLearner):
             if self.log:
                 self.log[-1]["neighbours_added"] = n
         return out
+
+    def _final_outcomes(self, state: WorldState, w: np.ndarray, feasible: np.ndarray) -> list:
+        """Bayes' decision over more plans: besides each likely goal's own plans, a plan for
+        the conjunction of two likely goals (their clauses together), so that a belief split
+        between compatible goals can be answered by a plan that satisfies both; every plan is
+        still chosen by its expected success Σ_z w_z 1[z holds after it]."""
+        outs = super()._final_outcomes(state, w, feasible)
+        m = self.config.final_joint
+        if m < 2:
+            return outs
+        likely = [self.hyps[i].goal for i in ranking.order(w, ranking.WEIGHT_DECIMALS)[:m] if w[i] > 0]
+        planned = {repr(o.plan) for o in outs}
+        for a, b in combinations(likely, 2):
+            joint = Goal(tuple(dict.fromkeys(a.clauses + b.clauses)), a.stays or b.stays)
+            plan = planner.plan(joint, state)
+            if plan and repr(plan) not in planned:
+                planned.add(repr(plan))
+                outs.append(predict(state, plan))
+        return outs
 
     def mass_of(self, key: str) -> float:
         """w of the goal with this key (0 when the belief does not hold it)."""
