@@ -378,7 +378,6 @@ def test_light_panda_is_written_once_for_every_process():
     """The light Panda's file name comes from its text, not from a per-process salted hash()
     (else every benchmark process leaves one more copy in the cache)."""
     import subprocess
-    import sys
 
     code = "from activeintent.sim.assets import light_panda_urdf; print(light_panda_urdf())"
     paths = {subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,

@@ -21,9 +21,10 @@ class _Clauses:
     methods (model-proposed ones) are asked one by one, as before."""
 
     def __init__(self, hyps: tuple[Hypothesis, ...]):
-        grammar = [i for i, h in enumerate(hyps) if _judged_by_clauses(h)]
+        by_clauses = [_judged_by_clauses(h) for h in hyps]
+        grammar = [i for i, yes in enumerate(by_clauses) if yes]
         self.grammar = np.array(grammar, dtype=int)
-        self.own = [i for i in range(len(hyps)) if not _judged_by_clauses(hyps[i])]
+        self.own = [i for i, yes in enumerate(by_clauses) if not yes]
         index: dict[tuple[str, str], int] = {}
         self.clauses = []
         width = max((len(hyps[i].clauses) for i in grammar), default=0)

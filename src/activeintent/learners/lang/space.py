@@ -226,8 +226,10 @@ class Compiled:
         if not len(rows):
             return
         uniq, inverse = np.unique(keys[rows], return_inverse=True)
-        went_off = np.array([not self.shapes[k // len(groups)][0].moved_ok(
-            fb, fa, groups[k % len(groups)], b, self.shapes[k // len(groups)][1]) for k in uniq.tolist()], bool)
+        went_off = np.zeros(len(uniq), bool)
+        for u, k in enumerate(uniq.tolist()):
+            struct, stp = self.shapes[k // len(groups)]
+            went_off[u] = not struct.moved_ok(fb, fa, groups[k % len(groups)], b, stp)
         inside[self._f_index[rows]] = True
         off[self._f_index[rows]] = went_off[inverse]
 
