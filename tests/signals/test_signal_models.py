@@ -150,6 +150,32 @@ def test_preference_likelihood_is_the_predictive_column_of_the_answer():
         PREF.predictive(shown[:1], judge, model)
 
 
+def test_preference_predictive_of_many_queries_is_each_querys_predictive_bit_for_bit():
+    """select_query reads the predictive of hundreds of pairs at once (blocks of queries); its
+    values must be exactly those of one query at a time, or the chosen queries would change."""
+    from itertools import combinations
+
+    from activeintent.signals.preference import PREDICTIVE_BLOCK
+
+    judge = HypothesisJudge(HYPS)
+    plans = [MATCH, HALF, SWAP, [], MATCH[:1], SWAP[:1], [PutOn(block="red block", target="blue block")]]
+    outcomes = [symbolic_trajectory(SCENE, START, plan) for plan in plans]
+    queries = [list(pair) for pair in combinations(outcomes, 2)] * 4  # more than one block
+    assert len(queries) > PREDICTIVE_BLOCK
+    for model in (PREF.learner_model(), PreferenceModel(beta=math.inf, lapse=0.0)):
+        many = list(PREF.predictive_many(queries, judge, model))
+        assert len(many) == len(queries)
+        for shown, table in zip(queries, many, strict=True):
+            assert np.array_equal(table, PREF.predictive(shown, judge, model))
+    with pytest.raises(ValueError, match="two trajectories"):
+        list(PREF.predictive_many([outcomes[:1]], judge, PREF.learner_model()))
+    # the signals' default: one query at a time
+    stop_shown = [[outcomes[0]], [outcomes[2]]]
+    stop_judge = FixedJudge([0, 2, -1])
+    for shown, table in zip(stop_shown, STOP.predictive_many(stop_shown, stop_judge, STOP.learner_model()), strict=True):
+        assert np.array_equal(table, STOP.predictive(shown, stop_judge, STOP.learner_model()))
+
+
 # ---------------------------------------------------------------------------------------------
 # stop: a stub judge on a three-step kinematic trajectory
 # z0 moves away at step 0, z1 at step 2, z2 never.

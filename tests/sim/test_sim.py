@@ -245,6 +245,38 @@ def test_frames_drawn_in_worker_processes_are_the_same(demo):
     assert all(np.array_equal(a, b) for a, b in zip(here, there, strict=True))
 
 
+def test_two_videos_drawn_at_once_get_their_first_frames_before_either_is_drawn(demo, monkeypatch):
+    """A round's videos are drawn at the same time (the web app shows them as they grow): each
+    video asks the render processes for its first chunk alone, then for at most ``workers``
+    chunks at a time, so the second video's first frames never queue behind the whole first."""
+    import activeintent.sim.render as render
+
+    assert render.warm_render_pool(2)
+    pool = render._render_pool(2)
+    asked: list[str] = []
+    submit = pool.submit
+
+    def recorded(fn, names, poses, *args):
+        asked.append(recorded.video)
+        return submit(fn, names, poses, *args)
+
+    times = frame_times(demo, 10)
+    chunks = -(-len(times) // render.CHUNK_FRAMES)
+    assert chunks >= 5
+    monkeypatch.setattr(pool, "submit", recorded)
+    recorded.video = "A"
+    a = render.render_frames(demo, times, (32, 24), workers=2)
+    next(a)  # A's first frame: its first chunk, then two more asked for
+    recorded.video = "B"
+    b = render.render_frames(demo, times, (32, 24), workers=2)
+    next(b)
+    assert asked == ["A", "A", "A", "B", "B", "B"]  # not all of A's chunks before B's first
+    recorded.video = "A"
+    rest = list(a)
+    assert len(rest) == len(times) - 1 and asked.count("A") == chunks
+    b.close()
+
+
 def test_frames_drawn_in_this_process_by_two_threads_are_each_their_own(demo):
     """Two sessions drawing the same scene in this process (no render processes) share one
     PyBullet client: each frame must still show its own pose, never the other thread's."""

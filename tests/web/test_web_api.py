@@ -29,10 +29,14 @@ def wait_for(predicate, timeout: float = 180.0, what: str = "condition"):
 
 
 def waiting_state(url: str, sid: str, round: int) -> dict:
+    """The state once ``round`` is on screen and its videos are complete (a round is shown while
+    its videos are still drawn: until then their files grow)."""
     def ready():
         s = httpx.get(f"{url}/api/sessions/{sid}").json()
         assert s["status"] not in ("failed", "cancelled"), s["error"]
-        return s if s["status"] == "waiting-for-answer" and s["question"]["round"] == round else None
+        if s["status"] != "waiting-for-answer" or s["question"]["round"] != round:
+            return None
+        return s if all(v["complete"] for v in s["question"]["videos"]) else None
 
     return wait_for(ready, what=f"round {round} of session {sid}")
 

@@ -84,6 +84,13 @@ def ready(page) -> None:
     page.wait_for_selector("#gate", state="hidden")
 
 
+def near_end(page, length: float, before: float) -> None:
+    """Jump the video to ``before`` seconds before its end. ``length`` is the server's: a browser
+    learns the length of a video that is still being drawn only once it has all of it."""
+    page.evaluate("([t, b]) => { const v = document.getElementById('video'); v.currentTime = Math.max(0, t - b); "
+                  "v.play(); }", [length, before])
+
+
 def test_two_round_preference_session(live_server, page, tmp_path):
     srv = live_server("bayes-preference", rounds=2, seed=3, **VIDEO)
     sid = start(page, srv.url, "P-pref", tmp_path)
@@ -171,9 +178,7 @@ def test_clicker_session_stops_at_a_known_moment(live_server, page, tmp_path):
     wait_videos(page, "video")
     ready(page)
     assert page.is_disabled("#good")  # not before the video has ended
-    page.evaluate(
-        "() => { const v = document.getElementById('video'); v.currentTime = Math.max(0, v.duration - 0.3); v.play(); }"
-    )
+    near_end(page, srv.manager.get(sid).state()["question"]["videos"][0]["duration"], 0.3)
     page.wait_for_selector("#good:enabled")
     page.click("#good")
 
@@ -373,13 +378,13 @@ def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
     assert page.evaluate("new Set([...document.querySelectorAll('#answers button')].map(b => b.className)).size") == 1
     page.keyboard.press("Enter")  # Ready
     page.wait_for_selector('#question[data-phase="first"]')
-    page.evaluate("() => { const v = document.getElementById('video'); v.currentTime = v.duration - 0.05; }")
+    video = session.state()["question"]["videos"][0]
+    near_end(page, video["duration"], 0.05)
     page.wait_for_selector('#question[data-phase="ended"]')
     assert page.is_disabled("#stop") and page.is_enabled("#good")
     page.keyboard.press("Space")  # too late: the video has ended
     page.wait_for_function("document.getElementById('status').textContent.includes('no longer counts')")
     assert page.is_visible("#replay")
-    video = session.state()["question"]["videos"][0]
     # the server refuses it too: once the page said the video ended, and at the video's end
     for _ in range(600):  # the page reports the end as it happens; wait for that report
         if session.viewing(1)["ended"] is not None:
@@ -413,7 +418,7 @@ def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
     wait_round(page, 2)
     wait_videos(page, "video")
     ready(page)
-    page.evaluate("() => { const v = document.getElementById('video'); v.currentTime = v.duration - 0.05; }")
+    near_end(page, session.state()["question"]["videos"][0]["duration"], 0.05)
     page.wait_for_selector("#good:enabled")
     page.click("#good")
 

@@ -5,6 +5,7 @@ parameters)."""
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Iterator
 from typing import ClassVar, Protocol
 
 import numpy as np
@@ -89,6 +90,13 @@ class Signal(ABC):
     @abstractmethod
     def predictive(self, shown: list[Trajectory], judge: Judge, model: BaseModel) -> np.ndarray:
         """[n, O] probabilities of O discretised answers, for expected information gain."""
+
+    def predictive_many(self, queries: list[list[Trajectory]], judge: Judge, model: BaseModel
+                        ) -> Iterator[np.ndarray]:
+        """:meth:`predictive` of each query in turn (a signal may compute them together; the
+        values must be the same)."""
+        for shown in queries:
+            yield self.predictive(shown, judge, model)
 
 
 SIGNALS: Registry[Signal] = Registry("signal")

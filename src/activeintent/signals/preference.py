@@ -24,6 +24,7 @@ from activeintent.world.trajectory import Trajectory
 
 CHOICES: tuple[str, str, str] = ("A", "B", "cant_choose")
 SIMILARITY_LENGTH = 0.05  # metres: a block 5 cm from its counterpart is e⁻¹ as similar
+PREDICTIVE_BLOCK = 64  # queries per block of predictive_many (memory: 64 × H × 3 floats)
 
 
 class PreferenceAnswer(Answer):
@@ -68,7 +69,7 @@ def choice_probabilities(u_a: np.ndarray, u_b: np.ndarray, sim: float, m: Prefer
         p[..., 1] = ~tie & (d < 0)
         p[..., 2] = tie
     else:
-        s = float(np.clip(sim, 0.0, 1.0))
+        s = np.clip(np.asarray(sim, float), 0.0, 1.0)  # a number, or one per row of d ([n, 1])
         logits = np.stack([m.beta * d / 2, -m.beta * d / 2, m.beta * (m.indifference - np.abs(d) / 2) + m.confusion * s], -1)
         logits -= logits.max(axis=-1, keepdims=True)
         p = np.exp(logits)
@@ -96,6 +97,25 @@ class PreferenceSignal(Signal):
 
     def predictive(self, shown, judge, model) -> np.ndarray:
         return self._probs(shown, judge, model)
+
+    def predictive_many(self, queries, judge, model):
+        """The same values as :meth:`predictive` per query, computed in blocks of queries:
+        each outcome's utilities once, the choice model on [queries, n] at a time."""
+        utilities: dict[int, np.ndarray] = {}
+
+        def u(traj: Trajectory) -> np.ndarray:
+            if id(traj) not in utilities:
+                utilities[id(traj)] = np.asarray(judge.utility(traj.outcome), float)
+            return utilities[id(traj)]
+
+        for start in range(0, len(queries), PREDICTIVE_BLOCK):
+            block = queries[start:start + PREDICTIVE_BLOCK]
+            for shown in block:
+                if len(shown) != 2:
+                    raise ValueError(f"a preference query shows two trajectories τ^a, τ^b; got {len(shown)}")
+            sims = np.array([[similarity(a.outcome, b.outcome)] for a, b in block])
+            yield from choice_probabilities(np.stack([u(a) for a, _ in block]), np.stack([u(b) for _, b in block]),
+                                            sims, model)
 
     def likelihood(self, answer, shown, judge, model) -> np.ndarray:
         if answer.choice is None:

@@ -267,14 +267,21 @@ def render_frames(traj: Trajectory, times: np.ndarray, size: tuple[int, int] = (
 
     pool = _render_pool(workers)
     chunks = [ticks[i:i + CHUNK_FRAMES] for i in range(0, len(ticks), CHUNK_FRAMES)]
-    futures = [pool.submit(_draw_chunk, list(traj.object_names), traj.object_poses[c], traj.joint_positions[c],
-                           size) for c in chunks]
-    for n, future in enumerate(futures):
+
+    def submit(c: list[int]):
+        return pool.submit(_draw_chunk, list(traj.object_names), traj.object_poses[c], traj.joint_positions[c], size)
+
+    # The first chunk alone, then at most ``workers`` at a time: videos drawn at once share the
+    # processes, and each one's first frames come first (a round's videos all start soon).
+    futures = [submit(chunks[0])]
+    for n in range(len(chunks)):
         try:
-            frames = future.result()
+            frames = futures[n].result()
         except BrokenProcessPool:  # a worker died: the rest in this process, the pool restarted next time
             _forget_pool(unstartable=n == 0 and not _pool_delivered)  # never drew a frame: it cannot start
             yield from _draw_here(traj, [k for c in chunks[n:] for k in c], size)
             return
         _mark_delivered()
+        while len(futures) < min(len(chunks), n + 1 + workers):
+            futures.append(submit(chunks[len(futures)]))
         yield from frames

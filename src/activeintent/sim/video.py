@@ -45,7 +45,10 @@ def export_video(
         writer = iio.get_writer(path, mode="I", duration=1000.0 / fps, loop=0)
     else:
         codec = "libvpx-vp9" if suffix == ".webm" else "libx264"
-        extra = ["-b:v", "0", "-crf", "34", "-deadline", "realtime", "-cpu-used", "8"] if suffix == ".webm" else [
+        # WebM: written in half-second clusters as the frames come (no look-ahead), so a browser
+        # can play the file while it grows (activeintent.web.live)
+        extra = ["-b:v", "0", "-crf", "34", "-deadline", "realtime", "-cpu-used", "8", "-lag-in-frames", "0",
+                 "-cluster_time_limit", "500", "-flush_packets", "1"] if suffix == ".webm" else [
             "-preset", "veryfast", "-crf", "23"
         ]
         writer = iio.get_writer(

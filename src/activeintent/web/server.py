@@ -20,7 +20,7 @@ from typing import Annotated, Any, Literal
 
 from fastapi import Depends, FastAPI, Request, Response
 from fastapi.concurrency import run_in_threadpool
-from fastapi.responses import FileResponse
+from fastapi.responses import FileResponse, StreamingResponse
 from fastapi.staticfiles import StaticFiles
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
@@ -29,6 +29,7 @@ from activeintent.signals import get_signal
 from activeintent.users.human import AnswerRejected, Question, stop_answer
 from activeintent.web.errors import ApiError, install_error_handlers
 from activeintent.web.limits import BodyGuard, Limits, SessionLimits, event_lines_size
+from activeintent.web.live import follow
 from activeintent.web.session import (
     SERVED_FILE,
     EpisodeBuilder,
@@ -404,6 +405,9 @@ def create_app(
             raise ApiError(404, "file_not_found", f"no file {name[:80]!r} in session {sid} "
                            "(only its .webm/.gif videos are served)")
         media = "video/webm" if path.suffix == ".webm" else "image/gif"
+        live = session.live_export(name)
+        if live is not None:  # still being drawn: sent as it grows (activeintent.web.live)
+            return StreamingResponse(follow(live), media_type=media, headers={"Cache-Control": "no-store"})
         return FileResponse(path, media_type=media, headers={"Cache-Control": "no-store"})
 
     for route, page in PAGES.items():

@@ -47,6 +47,7 @@ from activeintent.users.human import (
 )
 from activeintent.web.basics import VIDEO_SIZE, EstimateMode, parse_video_size, write_json
 from activeintent.web.errors import ApiError
+from activeintent.web.live import LiveExport
 
 SESSION_ID = re.compile(r"^[0-9a-f]{16}$")
 KEY_ID_CHARS = 16  # of the key's SHA-256: enough to tell browsers apart, useless to forge one
@@ -298,6 +299,7 @@ class WebSession:
         self.error: str | None = None
         self.final_video: VideoInfo | None = None
         self._final_trajectory: Any = None
+        self._live: dict[str, LiveExport] = {}  # file name -> its export (the round's videos)
         self._done = threading.Event()
         self._status_override: Status | None = None
         self._events_lock = threading.Lock()
@@ -339,6 +341,7 @@ class WebSession:
             recorder = StudyRecorder(self.dir, self.config, answered_by=self._answered_by.get)
             episode = self.builder(self.seed, self.dir, self.user, [recorder, self])
             result = episode.run()
+            self._finish_exports()
             if self._final_trajectory is not None:
                 self.final_video = self._export(self._final_trajectory, "final", "final")
             self.result = recorder.summary or study_summary(json.loads(result.model_dump_json()), self.config)
@@ -361,6 +364,8 @@ class WebSession:
                     episode.env.close()
                 except Exception:
                     pass
+            for export in list(self._live.values()):  # no file left half written when it ends
+                export.done.wait(60)
             self.ended = time.time()
             try:
                 self._write_session_file()
@@ -385,12 +390,8 @@ class WebSession:
         return not self._done.is_set()
 
     # -- the episode's hooks (worker thread) -----------------------------------------------
-    def _export(self, traj: Any, name: str, label: str) -> VideoInfo:
-        from activeintent.sim.video import export_video
-
+    def _video_info(self, traj: Any, name: str, label: str) -> VideoInfo:
         fps = self.config.fps
-        export_video(traj, self.dir / f"{name}.webm", fps=fps, size=self.config.video_size,
-                     workers=self.config.render_workers)
         return VideoInfo(
             label=label,
             file=f"{name}.webm",
@@ -401,12 +402,47 @@ class WebSession:
             trajectory_duration=traj.duration,
         )
 
+    def _export(self, traj: Any, name: str, label: str) -> VideoInfo:
+        """The whole video, written before this returns (the final attempt)."""
+        from activeintent.sim.video import export_video
+
+        export_video(traj, self.dir / f"{name}.webm", fps=self.config.fps, size=self.config.video_size,
+                     workers=self.config.render_workers)
+        return self._video_info(traj, name, label)
+
+    def _finish_exports(self) -> None:
+        """Wait until every round video is complete (a failed one fails the session)."""
+        for export in list(self._live.values()):
+            export.finish()
+
+    def live_export(self, name: str) -> LiveExport | None:
+        """The export still writing the file ``name``, or None (absent or complete)."""
+        export = self._live.get(name)
+        return export if export is not None and not export.done.is_set() else None
+
+    def _round_videos(self, round: int) -> list[tuple[str, str]]:
+        """(file stem, label) of a round's videos, in the order of its trajectories."""
+        if self.user.sig.shows == 2:
+            return [(f"round{round}_a", "A"), (f"round{round}_b", "B")]
+        return [(f"round{round}_y", "robot")]
+
+    def _start_export(self, traj: Any, name: str) -> LiveExport:
+        export = self._live.get(f"{name}.webm")
+        if export is None or export.trajectory is not traj:
+            if name.endswith(("_a", "_y")):  # a round's first video: the previous round's end first
+                self._finish_exports()
+            export = LiveExport(traj, self.dir / f"{name}.webm", self.config.fps, self.config.video_size,
+                                self.config.render_workers)
+            self._live[f"{name}.webm"] = export
+        return export
+
     def _present(self, q: Question) -> list[VideoInfo]:
-        if len(q.trajectories) == 2:
-            names = [(f"round{q.round}_a", "A"), (f"round{q.round}_b", "B")]
-        else:
-            names = [(f"round{q.round}_y", "robot")]
-        videos = [self._export(t, n, label) for t, (n, label) in zip(q.trajectories, names, strict=True)]
+        """The round's videos, drawn at once and shown as soon as each can start playing
+        (``web.live``)."""
+        names = self._round_videos(q.round)
+        for export in [self._start_export(t, n) for t, (n, _) in zip(q.trajectories, names, strict=True)]:
+            export.wait_playable()
+        videos = [self._video_info(t, n, label) for t, (n, label) in zip(q.trajectories, names, strict=True)]
         self.log_server(
             "round_presented",
             round=q.round,
@@ -531,7 +567,8 @@ class WebSession:
                 "kind": self.config.signal,
                 "scene": objects,
                 "legend": scene_legend(objects),
-                "videos": [v.model_dump() for v in (q.presented or [])],
+                # complete: the whole file is written (before that it is sent as it grows)
+                "videos": [{**v.model_dump(), "complete": self.live_export(v.file) is None} for v in (q.presented or [])],
                 "viewing": self.viewing(q.round),
             }
         guess = self.visible_guess()

@@ -127,8 +127,8 @@ def select_query(
         p_shown = float(weights @ p_answer)
         w_shown = weights * p_answer / p_shown
     gains = np.empty(len(combos))
-    for n, combo in enumerate(combos):
-        probs = signal.predictive([outs[i].traj for i in combo], judge, model)
+    predicted = signal.predictive_many([[outs[i].traj for i in combo] for combo in combos], judge, model)
+    for n, (combo, probs) in enumerate(zip(combos, predicted, strict=True)):
         if gain == "shown":
             g = p_shown * eig(w_shown, probs)
         elif gain == "shown-decision":

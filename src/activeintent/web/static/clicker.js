@@ -26,6 +26,8 @@
   // gate → first → ended (→ replay → ended …); the stop button works in first and replay only
   let phase = "gate";
   let endedAt = null; // client time the first viewing ended
+  // the video's length from the server: a video still being drawn plays before the browser knows it
+  let length = null;
 
   Study.watchVideo(video, "robot", () => shownRound);
   Study.setupLegend(document.getElementById("legend-toggle"), document.getElementById("legend"), () => shownRound);
@@ -37,7 +39,7 @@
   }
 
   function fraction(t) {
-    const d = video.duration;
+    const d = Number.isFinite(video.duration) ? video.duration : length;
     return Number.isFinite(d) && d > 0 ? Math.min(1, Math.max(0, t / d)) : 0;
   }
   video.addEventListener("timeupdate", () => {
@@ -71,9 +73,8 @@
     replayBtn.classList.add("hidden");
     Study.log("replay", { video: "robot" }, shownRound);
     status.textContent = "Replay: you may still stop the robot.";
-    video.currentTime = 0;
     setPhase("replay");
-    video.play().catch(() => {});
+    Study.restart(video);
   });
 
   function markStop(t) {
@@ -161,6 +162,7 @@
 
   function show(q) {
     const v = q.videos[0];
+    length = v.duration;
     clearStop();
     Study.fillLegend(document.getElementById("legend-list"), q.legend);
     Study.describeVideo(video, document.getElementById("caption"), "The robot tidying this table", q.legend, v.duration);

@@ -216,10 +216,23 @@ const Study = (() => {
       document.documentElement.style.setProperty("--video-width", `${video.videoWidth}px`);
       document.documentElement.style.setProperty("--video-aspect", `${video.videoWidth} / ${video.videoHeight}`);
     });
-    for (const type of ["loadedmetadata", "play", "playing", "pause", "seeked", "ended", "error"]) {
+    // "waiting": playback paused for frames not yet drawn (videos are shown while they are drawn)
+    for (const type of ["loadedmetadata", "play", "playing", "waiting", "pause", "seeked", "ended", "error"]) {
       video.addEventListener(type, () =>
         log(`video_${type}`, { video: label, time: video.currentTime, duration: video.duration }, roundOf()));
     }
+  }
+
+  // Play a video again from its start. A video sent while it was still being drawn cannot be
+  // seeked (the browser got it without a length): it is fetched again, whole now.
+  function restart(video) {
+    const s = video.seekable;
+    if (s.length > 0 && s.end(s.length - 1) > 0) {
+      video.currentTime = 0;
+    } else {
+      video.src = video.src;
+    }
+    return video.play().catch(() => {});
   }
 
   // Common routing: leave a round page when the session is over.
@@ -281,6 +294,6 @@ const Study = (() => {
   return {
     sessionId, now, api, log, flush, goTo, poll, setProgress, fillGuess, setEstimate, setWaiting, showFatal,
     watchVideo, routeFinished, isTyping, setupLegend, fillLegend, describeVideo, betweenRounds,
-    readyGate, reportVideo, orderButtons,
+    readyGate, reportVideo, orderButtons, restart,
   };
 })();

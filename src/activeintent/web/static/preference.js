@@ -17,10 +17,7 @@
   function replay(which) {
     if (videosBox.classList.contains("gated")) return; // nothing plays before Ready
     Study.log("replay", { video: which }, shownRound);
-    for (const v of which === "both" ? [videos.A, videos.B] : [videos[which]]) {
-      v.currentTime = 0;
-      v.play().catch(() => {});
-    }
+    for (const v of which === "both" ? [videos.A, videos.B] : [videos[which]]) Study.restart(v);
   }
   document.getElementById("replay-a").addEventListener("click", () => replay("A"));
   document.getElementById("replay-b").addEventListener("click", () => replay("B"));
