@@ -18,6 +18,7 @@ RESULTS = Path(__file__).resolve().parents[2] / "docs" / "results"
 PAPER = RESULTS / "paper"
 FAST = {"paper"}  # re-run in the fast suite; every other bench folder is re-run by a slow test
 NOT_BENCH = {"perf-lang": "benchmark timings (perf-bench JSON), not results",
+             "web-wait": "the web study's waits (web-bench JSON), not results",
              "coverage": "coverage of the goal language (re-run by tests/bench/test_coverage.py)",
              "redesign-equivalence": "its own replay scripts and README"}
 
