@@ -21,6 +21,7 @@ from activeintent.learners.lang.hypotheses import LangSpace
 from activeintent.learners.lang.learner import DECIDE, LangConfig, LangLearner
 from activeintent.learners.registry import LearnerContext, get_method
 from activeintent.signals import get_signal
+from activeintent.signals.base import Signal
 from activeintent.suites import resolve
 from activeintent.users.simulated import SimulatedUser, user_profile
 
@@ -76,6 +77,8 @@ class _TableSignal:
 
     def predictive(self, trajs, judge, model):
         return self.table[trajs[0]]
+
+    predictive_many = Signal.predictive_many  # one query at a time, as every signal may
 
 
 def test_the_decision_gain_prefers_the_query_that_separates_plans():

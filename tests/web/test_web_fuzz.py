@@ -128,10 +128,12 @@ def wait_for(predicate, timeout: float = 180.0, what: str = "condition"):
 def waiting_round(url: str, sid: str, n: int, client: httpx.Client | None = None) -> dict:
     get = (client or httpx).get
 
-    def ready():
+    def ready():  # round n on screen and its videos complete (until then their files grow)
         s = get(f"{url}/api/sessions/{sid}").json()
         assert s["status"] not in ("failed", "cancelled"), s["error"]
-        return s if s["status"] == "waiting-for-answer" and s["question"]["round"] == n else None
+        if s["status"] != "waiting-for-answer" or s["question"]["round"] != n:
+            return None
+        return s if all(v["complete"] for v in s["question"]["videos"]) else None
 
     return wait_for(ready, what=f"round {n} of {sid}")
 

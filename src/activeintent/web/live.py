@@ -3,9 +3,9 @@
 A round's videos are written by a background thread each (frames from the shared render
 processes, encoded to WebM in clusters of half a second); the round is shown as soon as every
 video holds its first complete cluster, and the browser receives the file as it grows (a
-chunked response that follows the file until the export has ended). Frames are drawn about
-twice as fast as they play, so the participant waits for the learner, the physics and one
-second of frames instead of whole videos (docs/webapp.md, "How long participants wait").
+chunked response that follows the file until the export has ended). Frames are drawn faster
+than they play, so the participant waits for the learner, the physics and half a second of
+frames instead of whole videos (docs/webapp.md, "How long participants wait").
 """
 
 from __future__ import annotations
@@ -30,7 +30,6 @@ class LiveExport:
 
     def __init__(self, traj: Any, path: Path, fps: int, size: tuple[int, int], workers: int):
         self.path = path
-        self.trajectory = traj
         self.done = threading.Event()
         self.error: str | None = None
         self.started_at = time.time()

@@ -426,21 +426,16 @@ class WebSession:
             return [(f"round{round}_a", "A"), (f"round{round}_b", "B")]
         return [(f"round{round}_y", "robot")]
 
-    def _start_export(self, traj: Any, name: str) -> LiveExport:
-        export = self._live.get(f"{name}.webm")
-        if export is None or export.trajectory is not traj:
-            if name.endswith(("_a", "_y")):  # a round's first video: the previous round's end first
-                self._finish_exports()
-            export = LiveExport(traj, self.dir / f"{name}.webm", self.config.fps, self.config.video_size,
-                                self.config.render_workers)
-            self._live[f"{name}.webm"] = export
-        return export
-
     def _present(self, q: Question) -> list[VideoInfo]:
         """The round's videos, drawn at once and shown as soon as each can start playing
         (``web.live``)."""
         names = self._round_videos(q.round)
-        for export in [self._start_export(t, n) for t, (n, _) in zip(q.trajectories, names, strict=True)]:
+        self._finish_exports()  # the previous round's videos first: two rounds never compete
+        exports = [LiveExport(traj, self.dir / f"{name}.webm", self.config.fps, self.config.video_size,
+                              self.config.render_workers) for traj, (name, _) in zip(q.trajectories, names, strict=True)]
+        for (name, _), export in zip(names, exports, strict=True):
+            self._live[f"{name}.webm"] = export
+        for export in exports:
             export.wait_playable()
         videos = [self._video_info(t, n, label) for t, (n, label) in zip(q.trajectories, names, strict=True)]
         self.log_server(
