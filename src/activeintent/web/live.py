@@ -32,8 +32,6 @@ class LiveExport:
         self.path = path
         self.done = threading.Event()
         self.error: str | None = None
-        self.started_at = time.time()
-        self.ended_at: float | None = None
         self._thread = threading.Thread(target=self._run, args=(traj, fps, size, workers),
                                         name=f"export-{path.stem}", daemon=True)
         self._thread.start()
@@ -46,7 +44,6 @@ class LiveExport:
         except Exception as err:  # reported by wait_playable / finish, never lost in the thread
             self.error = f"{type(err).__name__}: {err}"
         finally:
-            self.ended_at = time.time()
             self.done.set()
 
     def _has_frames(self) -> bool:
@@ -63,12 +60,14 @@ class LiveExport:
             if time.monotonic() > deadline:
                 raise TimeoutError(f"{self.path.name}: no frames within {timeout:.0f} s")
             time.sleep(POLL_S)
-        if self.error:
-            raise RuntimeError(f"the video {self.path.name} could not be made: {self.error}")
+        self._raise_if_failed()
 
     def finish(self, timeout: float | None = None) -> None:
         """Block until the file is complete; raise if the export failed."""
         self._thread.join(timeout)
+        self._raise_if_failed()
+
+    def _raise_if_failed(self) -> None:
         if self.error:
             raise RuntimeError(f"the video {self.path.name} could not be made: {self.error}")
 

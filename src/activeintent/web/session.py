@@ -431,10 +431,12 @@ class WebSession:
         (``web.live``)."""
         names = self._round_videos(q.round)
         self._finish_exports()  # the previous round's videos first: two rounds never compete
-        exports = [LiveExport(traj, self.dir / f"{name}.webm", self.config.fps, self.config.video_size,
-                              self.config.render_workers) for traj, (name, _) in zip(q.trajectories, names, strict=True)]
-        for (name, _), export in zip(names, exports, strict=True):
+        exports = []
+        for traj, (name, _) in zip(q.trajectories, names, strict=True):
+            export = LiveExport(traj, self.dir / f"{name}.webm", self.config.fps, self.config.video_size,
+                                self.config.render_workers)
             self._live[f"{name}.webm"] = export
+            exports.append(export)
         for export in exports:
             export.wait_playable()
         videos = [self._video_info(t, n, label) for t, (n, label) in zip(q.trajectories, names, strict=True)]

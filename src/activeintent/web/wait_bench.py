@@ -1,8 +1,8 @@
 """`activeintent web-bench`: how long a participant waits between rounds of the web study.
 
 The wait is what a person sits through after an answer before the next round's videos can be
-played: the learner's update and next query, the physics run and the first second of every
-video (the rest is drawn while it plays, ``activeintent.web.live``). It is measured on the real
+played: the learner's update and next query, the physics run and the first half second of
+every video (the rest is drawn while it plays, ``activeintent.web.live``). It is measured on the real
 app (FastAPI with its sessions, episodes and PyBullet, in process, through a test client), so
 the figures are the server's part of the wait (a browser adds the download). Each round is
 answered as soon as its videos are complete, never earlier than a participant who pressed Ready
