@@ -70,6 +70,13 @@ class Pool:
         self.outs: list[Outcome] = []
         self.seen: set[tuple] = set() if keep_nothing else {state_key(facts(state))}
 
+    def extend(self, outs: list[Outcome]) -> None:
+        """Add already predicted outcomes (distinct ones only)."""
+        for o in outs:
+            if o.key not in self.seen:
+                self.seen.add(o.key)
+                self.outs.append(o)
+
     def add(self, plan: list[Skill]) -> bool:
         o = predict(self.state, plan)
         if any(not s.ok for s in o.traj.steps):
@@ -152,7 +159,20 @@ def _prior():
     return b.hyps, b.weights
 
 
-def reward_plans(pool: Pool, w: np.ndarray, depth: int = 4) -> None:
+def successor_features(state: WorldState, memo: dict | None = None) -> np.ndarray:
+    """φ of every successor of ``state`` [moves, d], in ``successors`` order (memoised in
+    ``memo`` by exact state: a test scene's successors are the same at every k)."""
+    key = _key(state)
+    got = memo.get(key) if memo is not None else None
+    if got is None:
+        succ = successors(state)
+        got = np.array([phi(s) for _, s in succ]) if succ else np.zeros((0, len(phi(state))))
+        if memo is not None:
+            memo[key] = got
+    return got
+
+
+def reward_plans(pool: Pool, w: np.ndarray, depth: int = 4, memo: dict | None = None) -> None:
     """Greedy ascent on r(s) = w · φ(s) from the scene's layout, every prefix kept."""
     state, plan = pool.state, []
     r = float(w @ phi(state))
@@ -160,7 +180,7 @@ def reward_plans(pool: Pool, w: np.ndarray, depth: int = 4) -> None:
         succ = successors(state)
         if not succ:
             break
-        vals = np.array([phi(s) for _, s in succ]) @ w
+        vals = successor_features(state, memo) @ w
         j = ranking.argmax(vals)
         if not ranking.greater(float(vals[j]), r):
             break

@@ -55,10 +55,11 @@ def _class_mask(color: str) -> np.ndarray:
     return m
 
 
-def _components(nodes: list[str], linked) -> list[list[str]]:
+def _components(adj: dict[str, set[str]]) -> list[list[str]]:
+    """Connected components of a symmetric adjacency (every node a key)."""
     seen: set[str] = set()
     out = []
-    for n in nodes:
+    for n in adj:
         if n in seen:
             continue
         comp, todo = [], [n]
@@ -66,71 +67,93 @@ def _components(nodes: list[str], linked) -> list[list[str]]:
         while todo:
             a = todo.pop()
             comp.append(a)
-            for b in nodes:
-                if b not in seen and linked(a, b):
+            for b in adj[a]:
+                if b not in seen:
                     seen.add(b)
                     todo.append(b)
         out.append(comp)
     return out
 
 
-def _line(f: Facts, a: str, b: str, axis: int) -> bool:
-    """a and b flat, side by side and aligned across ``axis`` (1: a left-right row, 0: a column)."""
-    return (f.flat(a) and f.flat(b) and f.next_to(a, b)
-            and abs(f.xy[a][axis] - f.xy[b][axis]) <= ALIGN_TOL)
+class _Graphs:
+    """The block graphs φ reads, built once per state: neighbours (``Facts.near``), blocks
+    touching (neighbours or stacked), and flat neighbours aligned in a row / a column."""
+
+    def __init__(self, f: Facts):
+        blocks = set(f.blocks)
+        self.near: dict[str, set[str]] = {n: set() for n in (*f.blocks, *f.bowls)}
+        for pair in f.near:
+            if len(pair) == 2:
+                a, b = tuple(pair)
+                self.near.setdefault(a, set()).add(b)
+                self.near.setdefault(b, set()).add(a)
+        self.touching = {b: self.near[b] & blocks for b in f.blocks}
+        for b in f.blocks:
+            under = f.below.get(b)
+            if under is not None and under in blocks and under != b:
+                self.touching[b].add(under)
+                self.touching[under].add(b)
+        flat = {b for b in f.blocks if f.flat(b)}
+        self.row = {b: set() for b in f.blocks}
+        self.column = {b: set() for b in f.blocks}
+        for a in flat:
+            for b in self.near[a] & flat:
+                if a != b:
+                    if abs(f.xy[a][1] - f.xy[b][1]) <= ALIGN_TOL:
+                        self.row[a].add(b)
+                    if abs(f.xy[a][0] - f.xy[b][0]) <= ALIGN_TOL:
+                        self.column[a].add(b)
 
 
-def block_relations(f: Facts) -> dict[str, np.ndarray]:
-    """Per block, the 0/1 vector of RELATIONS."""
-    blocks = list(f.blocks)
-    bowls = list(f.bowls)
-    stacked = lambda a, b: f.below.get(a) == b or f.below.get(b) == a  # noqa: E731
-    touching = lambda a, b: f.next_to(a, b) or stacked(a, b)  # noqa: E731
-    group = {b for comp in _components(blocks, touching) if len(comp) > 1 for b in comp}
+def block_relations(f: Facts, g: _Graphs | None = None) -> dict[str, list[bool]]:
+    """Per block, the 0/1 list of RELATIONS."""
+    g = g or _Graphs(f)
+    blocks = set(f.blocks)
+    bowls = set(f.bowls)
+    group = {b for comp in _components(g.touching) if len(comp) > 1 for b in comp}
     out = {}
-    for b in blocks:
+    for b in f.blocks:
         own = f"{color_of(b)} bowl"
         bowl = f.bowl_of.get(b)
-        near_bowls = [w for w in bowls if f.next_to(b, w)]
-        v = [
+        near_bowls = g.near[b] & bowls
+        cell = f.cell.get(b)
+        out[b] = [
             bowl is not None,
             bowl == own,
             bowl is not None and bowl != own,
             f.below.get(b) is not None,
             f.above.get(b) is not None,
             f.flat(b),
-            any(f.next_to(b, o) for o in blocks if o != b),
+            bool(g.near[b] & blocks - {b}),
             bool(near_bowls),
             own in near_bowls,
-            any(w != own for w in near_bowls),
-            *(f.cell.get(b) == r for r in REGIONS),
-            any(_line(f, b, o, 1) for o in blocks if o != b),
-            any(_line(f, b, o, 0) for o in blocks if o != b),
+            bool(near_bowls - {own}),
+            *(cell == r for r in REGIONS),
+            bool(g.row[b]),
+            bool(g.column[b]),
             f.below.get(b) is not None or f.above.get(b) is not None,
             b in group,
         ]
-        out[b] = np.array(v, float)
     return out
 
 
-def _globals(f: Facts) -> np.ndarray:
+def _globals(f: Facts, g: _Graphs) -> np.ndarray:
     blocks = list(f.blocks)
     n = max(len(blocks), 1)
     bases = [b for b in blocks if f.below.get(b) is None]
     heights = [len(f.tower(b)) for b in bases] or [0]
     towers = sum(h >= 2 for h in heights)
-    stacked = lambda a, b: f.below.get(a) == b or f.below.get(b) == a  # noqa: E731
-    groups = _components(blocks, lambda a, b: f.next_to(a, b) or stacked(a, b))
-    rows = _components(blocks, lambda a, b: _line(f, a, b, 1))
-    cols = _components(blocks, lambda a, b: _line(f, a, b, 0))
+    groups = _components(g.touching)
+    rows = _components(g.row)
+    cols = _components(g.column)
     per_bowl = [sum(f.bowl_of.get(b) == w for b in blocks) for w in f.bowls]
     regions = {f.cell.get(b) for b in blocks}
     return np.array([
         max(heights) / n if max(heights) >= 2 else 0.0,
         towers / n,
-        max((len(g) for g in groups if len(g) > 1), default=0) / n,
-        max((len(g) for g in rows if len(g) > 1), default=0) / n,
-        max((len(g) for g in cols if len(g) > 1), default=0) / n,
+        max((len(c) for c in groups if len(c) > 1), default=0) / n,
+        max((len(c) for c in rows if len(c) > 1), default=0) / n,
+        max((len(c) for c in cols if len(c) > 1), default=0) / n,
         sum(c > 0 for c in per_bowl) / max(len(per_bowl), 1),
         max(per_bowl, default=0) / n,
         len(regions) / n if blocks else 0.0,
@@ -142,15 +165,16 @@ def phi_facts(f: Facts) -> np.ndarray:
     got = f.memo.get("reward-phi")
     if got is not None:
         return got
-    rel = block_relations(f)
-    sums = np.zeros((len(CLASSES), len(RELATIONS)))
-    counts = np.zeros(len(CLASSES))
-    for b, v in rel.items():
-        m = _class_mask(color_of(b))
-        sums[m] += v
-        counts[m] += 1
+    g = _Graphs(f)
+    rel = block_relations(f, g)
+    if rel:
+        masks = np.array([_class_mask(color_of(b)) for b in rel], float)  # [blocks, classes]
+        sums = masks.T @ np.array(list(rel.values()), float)  # exact: sums of 0/1
+        counts = masks.sum(axis=0)
+    else:
+        sums, counts = np.zeros((len(CLASSES), len(RELATIONS))), np.zeros(len(CLASSES))
     frac = np.divide(sums, counts[:, None], out=np.zeros_like(sums), where=counts[:, None] > 0)
-    got = np.concatenate([frac.reshape(-1), _globals(f)])
+    got = np.concatenate([frac.reshape(-1), _globals(f, g)])
     got.setflags(write=False)
     f.memo["reward-phi"] = got
     return got
