@@ -112,3 +112,23 @@ def test_same_seed_same_episode(tmp_path, method):
     first = once(tmp_path / "a")
     assert first == once(tmp_path / "b")
     assert first[0] != once(tmp_path / "c", seed=10)[0]  # the seed matters
+
+
+def test_final_answer_does_not_depend_on_the_scenes_asked_before():
+    """What final answers reuse across k (the planner's plans on the prior, successors' φ) is
+    kept per exact layout and drawn from a generator of the scene's own: a test scene's answer
+    is the same whether or not other scenes were answered first, and asking again repeats it."""
+    from activeintent.learners.bayes.hypotheses import random_scene
+
+    rng = np.random.default_rng(3)
+    scenes = [random_scene(rng) for _ in range(3)]
+    states = [WorldState(positions=layout(s, int(rng.integers(2**31)))) for s in scenes]
+    warm = RewardLearner("preference", rng=4)
+    answers = [warm.final(s, st).plans for s, st in zip(scenes, states, strict=True)]
+    assert len({repr(a) for a in answers}) > 1  # the scenes differ, so do their answers
+    for i in (2, 0):
+        cold = RewardLearner("preference", rng=4)
+        assert cold.final(scenes[i], states[i]).plans == answers[i]
+        assert warm.final(scenes[i], states[i]).plans == answers[i]
+        kept = [o.plan for o in warm._final_base(states[i])]
+        assert kept == [o.plan for o in cold._final_base(states[i])] and len(kept) > 1
