@@ -15,20 +15,24 @@ from chat_server import GOALS, PROGRAM, ChatServer, schema_name
 
 from activeintent.act.base import ExecutionFailure
 from activeintent.learners.base import Estimate, RoundRecord
-from activeintent.learners.faithful import (
+from activeintent.learners.paper.faithful import (
     FaithfulConfig,
     FaithfulMllmLearner,
     FaithfulMllmLlmLearner,
     FaithfulPreferenceLearner,
 )
-from activeintent.learners.paper import MllmLlmLearner, PaperLearnerConfig, failure_reason
-from activeintent.learners.registry import LearnerContext, get_method
-from activeintent.learners.retrievers import (
+from activeintent.learners.paper.retrievers import (
     as_view_text,
     faithful_prompt_h,
     faithful_symbolic_retrieval,
     prompt_h,
 )
+from activeintent.learners.paper.structured import (
+    MllmLlmLearner,
+    PaperLearnerConfig,
+    failure_reason,
+)
+from activeintent.learners.registry import LearnerContext, get_method
 from activeintent.llm.base import ImagePart
 from activeintent.llm.scripted import ScriptedModel
 from activeintent.records import read_rounds
@@ -104,7 +108,7 @@ def test_epsilon_and_the_early_threshold_are_separate():
 
 
 def test_a_picture_shows_the_block_in_the_gripper():
-    from activeintent.learners.retrievers import describe_view
+    from activeintent.learners.paper.retrievers import describe_view
 
     lifted = dict(layout(SCENE, 3))
     x, y, _ = lifted["red block"]

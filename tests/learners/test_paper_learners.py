@@ -8,14 +8,14 @@ import pytest
 
 from activeintent.learners import prompts
 from activeintent.learners.base import Estimate, RoundRecord
-from activeintent.learners.paper import (
+from activeintent.learners.paper.retrievers import as_text, prompt_h
+from activeintent.learners.paper.schemas import goal_pattern, goals_schema
+from activeintent.learners.paper.structured import (
     MllmLearner,
     MllmLlmLearner,
     PaperLearnerConfig,
     PreferenceLearner,
 )
-from activeintent.learners.retrievers import as_text, prompt_h
-from activeintent.learners.schemas import goal_pattern, goals_schema
 from activeintent.llm.base import ImagePart
 from activeintent.llm.scripted import ScriptedModel
 from activeintent.signals.preference import PreferenceAnswer
@@ -177,7 +177,7 @@ def test_stop_learner_takes_a_new_scene_answer_without_retrieving():
 
 
 def test_symbolic_retrieval_does_not_read_a_failed_execution_as_approval():
-    from activeintent.learners.retrievers import symbolic_retrieval
+    from activeintent.learners.paper.retrievers import symbolic_retrieval
 
     nothing = kinematic_trajectory(SCENE, 3, [])
     ph = prompt_h(nothing, StopAnswer(), "g", 2.0)

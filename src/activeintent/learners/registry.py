@@ -71,7 +71,7 @@ def _paper(kind: str) -> Callable[[LearnerContext], Learner]:
         if kind == "mllm-llm" and ctx.retriever not in ("vision", "symbolic"):
             raise ValueError(f"Unknown retriever {ctx.retriever!r}; valid retrievers: vision, symbolic.")
         if ctx.variant == "faithful":
-            from activeintent.learners import faithful as f
+            from activeintent.learners.paper import faithful as f
 
             cfg = f.FaithfulConfig(design_scenes=ctx.design_scenes, epsilon=ctx.epsilon,
                                    early_threshold=ctx.early_threshold, seed=ctx.seed)
@@ -80,7 +80,7 @@ def _paper(kind: str) -> Callable[[LearnerContext], Learner]:
             if kind == "mllm":
                 return f.FaithfulMllmLearner(ctx.vlm or ctx.llm, cfg)  # type: ignore[arg-type]
             return f.FaithfulMllmLlmLearner(ctx.llm, ctx.vlm, retriever=ctx.retriever, config=cfg)  # type: ignore[arg-type]
-        from activeintent.learners import paper as p
+        from activeintent.learners.paper import structured as p
 
         config = p.PaperLearnerConfig(design_scenes=ctx.design_scenes, epsilon=ctx.epsilon,
                                       early_threshold=ctx.early_threshold)

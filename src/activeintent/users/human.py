@@ -83,7 +83,6 @@ def stop_answer(traj: Trajectory, t: float, fps: int) -> StopAnswer:
                       frame=int(math.floor(stop_time * fps + 1e-9)))
 
 
-stop_feedback = stop_answer  # the name used before signals became plug-ins
 
 
 class HumanUser:

@@ -102,10 +102,6 @@ class Observation:
     refuse: float = 0.0  # q(s) when answered: the needs belief's P(the scene lacks what is needed)
 
     @property
-    def feedback(self) -> Answer:  # the name proposals.py reads
-        return self.answer
-
-    @property
     def finals(self):
         return [facts(t.outcome) for t in self.shown]
 
@@ -385,4 +381,4 @@ class RandomQueryLearner(BayesLearner):
     def __init__(self, signal, rng=None, llm=None, config: BayesConfig | None = None, hypotheses=None):
         config = (config or BayesConfig()).model_copy(update={"choose": "random"})
         super().__init__(signal, rng, llm, config, hypotheses)
-        self.name = f"random-query-{self.signal}"
+        self.name = "random-query" if self.signal == "stop" else f"random-query-{self.signal}"  # the CLI names

@@ -182,9 +182,8 @@ def compile_proposal(p: ProposedIntention, runner: PredicateRunner, probes: list
 def _summarise(observations) -> str:
     lines = []
     for i, obs in enumerate(observations, 1):
-        fb = obs.feedback
         shown = "; ".join(obs.texts) if getattr(obs, "texts", None) else "(not recorded)"
-        lines.append(f"{i}. scene {obs.scene}: outcome(s): {shown}. Answer: {fb.describe()}.")
+        lines.append(f"{i}. scene {obs.scene}: outcome(s): {shown}. Answer: {obs.answer.describe()}.")
     return "\n".join(lines) or "(none yet)"
 
 

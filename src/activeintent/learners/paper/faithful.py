@@ -1,6 +1,6 @@
 """The paper's three learners as the paper ran them (``--variant faithful``, the default).
 
-What makes them faithful, against the ``structured`` variant in :mod:`activeintent.learners.paper`:
+What makes them faithful, against the ``structured`` variant in :mod:`activeintent.learners.paper.structured`:
 
 - z and y are free text. Every answer starts with the model's own reasoning, then z, then y
   (one JSON object whose first field is ``reasoning``: grammar-constrained for the embedded
@@ -31,8 +31,7 @@ from pydantic import BaseModel, ValidationError
 
 from activeintent.learners import prompts
 from activeintent.learners.base import Estimate, Learner, RoundRecord
-from activeintent.learners.paper import PaperLearnerConfig, failure_reason
-from activeintent.learners.retrievers import (
+from activeintent.learners.paper.retrievers import (
     PromptH,
     as_images,
     as_view_text,
@@ -41,11 +40,12 @@ from activeintent.learners.retrievers import (
     faithful_prompt_h,
     faithful_symbolic_retrieval,
 )
-from activeintent.learners.schemas import (
+from activeintent.learners.paper.schemas import (
     FaithfulRetrieval,
     faithful_answer_schema,
     faithful_scene_schema,
 )
+from activeintent.learners.paper.structured import PaperLearnerConfig, failure_reason
 from activeintent.llm.base import (
     ChatModel,
     ImagePart,

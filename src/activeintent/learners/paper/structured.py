@@ -1,6 +1,6 @@
 """The paper's three learners, ``--variant structured``: `preference` (eq. 1–2), `mllm-llm`
 (eq. 3–6), `mllm`. The paper's own way of running them (free text, reasoning, multi-turn
-memory, sampling) is ``--variant faithful``, the default, in :mod:`activeintent.learners.faithful`.
+memory, sampling) is ``--variant faithful``, the default, in :mod:`activeintent.learners.paper.faithful`.
 
 Each round the model p_θ estimates the intention z_{i+1} from the history, then the
 instruction(s) y_{i+1} given z_{i+1}; stop-signal methods first turn the user's stop h_i into
@@ -19,7 +19,7 @@ from pydantic import BaseModel, ValidationError
 
 from activeintent.learners import prompts
 from activeintent.learners.base import Estimate, Learner, RoundRecord
-from activeintent.learners.retrievers import (
+from activeintent.learners.paper.retrievers import (
     PromptH,
     as_images,
     as_text,
@@ -28,7 +28,7 @@ from activeintent.learners.retrievers import (
     symbolic_retrieval,
     vision_messages,
 )
-from activeintent.learners.schemas import (
+from activeintent.learners.paper.schemas import (
     IntentionAnswer,
     RetrievalAnswer,
     goals_schema,
