@@ -57,6 +57,20 @@ def test_new_scene_is_an_answer_of_every_signal():
     assert PREF.new_scene().choice is None and STOP.new_scene().stop_time is None
 
 
+def test_an_answer_has_one_word_everywhere():
+    """Answer.kind is the word records, reports and study exports use (one per answer kind)."""
+    from activeintent.signals import answer_kind_from_dump
+
+    pref, stop = get_signal("preference"), get_signal("stop")
+    answers = {"A": pref.parse({"choice": "A"}), "cant_choose": pref.parse({"choice": "cant_choose"}),
+               "stop": stop.parse({"stop_time": 1.5}), "no_stop": stop.parse({"stop_time": None}),
+               "new_scene": stop.new_scene()}
+    for word, answer in answers.items():
+        assert answer.kind == word
+        assert answer_kind_from_dump(answer.model_dump(mode="json")) == word
+    assert answer_kind_from_dump({"signal": "rating", "stars": 4}) == "rating"  # a signal not registered here
+
+
 def test_parse_refuses_unknown_fields_and_bad_values():
     assert STOP.parse({"stop_time": 1.5, "tick": 15}).stop_time == 1.5
     assert PREF.parse({"choice": "B"}).choice == "B"

@@ -452,7 +452,7 @@ def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
     assert row["button_order"] == " ".join(session.enrolment.button_order)
     assert row["final_scene_feasible"] == "true" and row["final_scene_index"] == "2"
     assert row["round1_answer"] == "stop" and row["round1_viewing"] == "replay"
-    assert row["round1_after_end_presses"] == "3" and row["round2_answer"] == "looks_good"
+    assert row["round1_after_end_presses"] == "3" and row["round2_answer"] == "no_stop"
     assert float(row["round1_stop_time"]) == pytest.approx(target, abs=1e-3)
     # one participant: the link's pid, proved by the key cookie of the browser that consented
     assert row["key_id"] == info["key_id"] == row["round1_key"] == row["round2_key"]

@@ -9,7 +9,7 @@ from collections.abc import Iterator
 from typing import ClassVar, Protocol
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict
+from pydantic import BaseModel, ConfigDict, ValidationError
 
 from activeintent.registry import Registry
 from activeintent.world.state import WorldState
@@ -33,16 +33,30 @@ class Answer(BaseModel):
     def _describe(self) -> str:
         return str(self.model_dump(exclude={"signal", "new_scene"}))
 
+    @property
+    def kind(self) -> str:
+        """One word for h, the same in records, reports and exports: ``new_scene`` or the
+        signal's own word (preference: A, B, cant_choose; stop: stop, no_stop)."""
+        return "new_scene" if self.new_scene else self._kind()
+
+    def _kind(self) -> str:
+        return self.signal
+
 
 def answer_kind_from_dump(d: dict) -> str:
-    """A short label of an answer (as stored): new_scene, stop, no_stop, the choice…"""
+    """``Answer.kind`` of an answer as stored (by its signal's answer model; records of a
+    signal not registered in this process: new_scene or the signal's name)."""
     if d.get("new_scene"):
         return "new_scene"
-    if "choice" in d:
-        return str(d["choice"])
-    if "stop_time" in d:
-        return "no_stop" if d["stop_time"] is None else "stop"
-    return str(d.get("signal"))
+    name = d.get("signal")
+    if not isinstance(name, str):
+        return "?"
+    if name in SIGNALS:
+        try:
+            return get_signal(name).Answer.model_validate(d).kind
+        except ValidationError:
+            pass
+    return name
 
 
 class Judge(Protocol):

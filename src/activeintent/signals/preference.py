@@ -39,6 +39,9 @@ class PreferenceAnswer(Answer):
             None: "no answer",
         }[self.choice]
 
+    def _kind(self) -> str:
+        return str(self.choice)
+
 
 class PreferenceModel(BaseModel):
     """Parameters of the choice model (a user's true ones, or a learner's assumption)."""

@@ -41,6 +41,9 @@ class StopAnswer(Answer):
             return "the user watched to the end without stopping the robot"
         return f"the user stopped the robot at t = {self.stop_time:.2f} s"
 
+    def _kind(self) -> str:
+        return "no_stop" if self.stop_time is None else "stop"
+
 
 class StopModel(BaseModel):
     """Parameters of the stop model (a user's true ones, or a learner's assumption)."""

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from activeintent.records import dumps
+from activeintent.signals import answer_kind_from_dump
 
 SESSION_COLUMNS = [
     "session", "participant", "pid", "study_id", "prolific_session_id", "condition", "consented",
@@ -61,17 +62,6 @@ def _read_lines(path: Path) -> list[dict]:
         if isinstance(value, dict):
             out.append(value)
     return out
-
-
-def answer_label(h: dict) -> str:
-    """A short word for an answer: A, B, cant_choose, new_scene, stop, looks_good, …"""
-    if h.get("new_scene"):
-        return "new_scene"
-    if "choice" in h:
-        return str(h["choice"])
-    if "stop_time" in h:
-        return "looks_good" if h["stop_time"] is None else "stop"
-    return str(h.get("signal", "?"))
 
 
 def _status(info: dict, folder: Path, events: list[dict]) -> str:
@@ -115,7 +105,7 @@ def session_record(folder: Path) -> dict:
         h = r.get("answer") if isinstance(r.get("answer"), dict) else {}
         t0, t1 = presented.get(n), answered_at.get(n)
         response = round(t1 - t0, 3) if isinstance(t0, int | float) and isinstance(t1, int | float) else None
-        label = answer_label(h)
+        label = answer_kind_from_dump(h)
         # who gave the answer, as the server saw it (sessions before the key cookie: unknown)
         by = r.get("answered_by") or answered_by.get(n)
         by = by if isinstance(by, dict) else {}

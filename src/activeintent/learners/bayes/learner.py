@@ -35,7 +35,7 @@ from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space,
 from activeintent.learners.bayes.judge import HypothesisJudge
 from activeintent.learners.bayes.needs import Needs, p_answered, p_new_scene
 from activeintent.llm.base import ChatModel, ModelError
-from activeintent.signals import Answer, Signal, answer_kind_from_dump, get_signal
+from activeintent.signals import Answer, Signal, get_signal
 from activeintent.world import (
     Scene,
     WorldState,
@@ -51,11 +51,6 @@ def kl_bits(after: np.ndarray, before: np.ndarray) -> float:
     """KL(after ‖ before) in bits: the information one answer gave the belief."""
     m = after > 0
     return float((after[m] * np.log2(after[m] / np.clip(before[m], 1e-300, None))).sum())
-
-
-def answer_kind(answer: Answer) -> str:
-    """new_scene, stop, no_stop, a, b, none…: the label the report counts."""
-    return answer_kind_from_dump(answer.model_dump(mode="json"))
 
 
 class BayesConfig(BaseModel):
@@ -304,7 +299,7 @@ class BayesLearner(Learner):
             self.needs.update(tuple(record.scene.objects), answer.new_scene, shown)
         gain = record.estimate.why.get("eig_nats") if record.estimate is not None else None
         self.answer_log.append({
-            "answer": answer_kind(answer),
+            "answer": answer.kind,
             "kl_bits": round(kl_bits(self.weights, before), 4),  # what this answer taught: KL(w' ‖ w)
             "gain_bits": None if gain is None else round(gain / math.log(2), 4),  # what the query promised
             "shown_mass": round(shown, 4),  # the belief's P(the scene can show z) before the answer
