@@ -273,7 +273,7 @@ class Episode:
         """The learner's current answer on the test scenes (``final``: the whole pool, else the
         curve's); success over the feasible ones. Physics (a physics env, ``final`` only) runs on
         the curve's scenes."""
-        physics = final and self.env.name != "symbolic"
+        physics = final and self.env.physical
         # The final attempt shown (final.gif, the web's final video) is on a scene that can show
         # the intention: the same scene final_z comes from (a web study may ask for the first).
         # Asking feasibility before the learner answers is safe: the learner never sees it.

@@ -14,6 +14,7 @@ from activeintent.world.trajectory import Trajectory
 class Env(Protocol):
     name: str
     renders: bool  # can its trajectories be drawn (frames for MLLMs, videos for people)?
+    physical: bool  # does it simulate physics (then final answers are also scored in it)?
 
     def reset(self, scene: Scene, seed: int) -> WorldState:
         """Lay ``scene`` out from ``seed``; returns the initial state."""

@@ -55,6 +55,7 @@ class SymbolicEnv:
 
     name = "symbolic"
     renders = False
+    physical = False
 
     def __init__(self) -> None:
         self.scene: Scene | None = None

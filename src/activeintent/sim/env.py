@@ -86,6 +86,7 @@ class PyBulletEnv:
 
     name = "pybullet"
     renders = True
+    physical = True
 
     def __init__(self, config: SimConfig | None = None):
         self.config = config or SimConfig()
