@@ -87,7 +87,7 @@ class LiveTable:
     def answered(self, log) -> None:
         from rich.markup import escape
 
-        from activeintent.episode import answer_kind_from_dump
+        from activeintent.signals import answer_kind_from_dump
 
         h = log.answer
         kind = answer_kind_from_dump(h)

@@ -36,19 +36,18 @@ from activeintent.protocol import (
     DEFAULT_BUDGET,
     DEFAULT_TEST_POOL,
     DEFAULT_TEST_SCENES,
-    FORMAT_VERSION,
     FREE_NEW_SCENES,
     NewSceneRule,
     draw_test_scenes,
     sample_round_scene,
 )
 from activeintent.provenance import provenance
-from activeintent.records import EpisodeRecorder
+from activeintent.records import EpisodeRecorder, EpisodeResult, RoundLog, TestLog
 from activeintent.signals import Answer, answer_kind_from_dump
 from activeintent.world import Scene, Skill, WorldState, apply_plan, describe_plan, layout
 from activeintent.world.trajectory import Trajectory
 
-__all__ = ["Episode", "EpisodeConfig", "EpisodeResult", "answer_kind_from_dump"]
+__all__ = ["Episode", "EpisodeConfig", "EpisodeResult", "RoundLog", "TestLog", "answer_kind_from_dump"]  # records: re-exported
 
 
 class EpisodeConfig(BaseModel):
@@ -89,81 +88,6 @@ class EpisodeSeeds:
         if test_seed is not None:
             kids[4] = int(np.random.SeedSequence(test_seed).generate_state(1)[0])
         return cls(*kids)
-
-
-class RoundLog(BaseModel):
-    round: int
-    scene: list[str]
-    scene_source: str
-    layout_seed: int
-    z: str
-    goals: list[str]
-    labels: list[str]  # "A", "B" for two trajectories, "y" for one
-    plans: list[str]
-    failures: list[str | None]
-    executed: list[bool]  # did anything move in each τ?
-    answer: dict
-    counted: bool  # did this answer use the budget?
-    signals_used: int  # counted answers so far, this one included
-    retrieved: str | None
-    retriever: str | None
-    variant: str | None = None  # the paper methods' variant (faithful | structured)
-    done: bool
-    why: dict = Field(default_factory=dict)
-    calls: list[dict] = Field(default_factory=list)
-    timing: dict[str, float] = Field(default_factory=dict)
-
-
-class TestLog(BaseModel):
-    scene: list[str]
-    layout_seed: int
-    z: str
-    goal: str
-    plan: str
-    failure: str | None
-    feasible: bool  # can the hidden intention be satisfied here? (decided after the answer)
-    success: bool  # symbolic outcome
-    success_physics: bool | None = None  # at k = K in the pybullet env
-
-
-class EpisodeResult(BaseModel):
-    format: int = FORMAT_VERSION
-    method: str
-    intention: str
-    seed: int
-    test_seed: int
-    env: str
-    budget: int
-    new_scene: str
-    success: float | None  # success@K: share of the feasible scenes of the whole test pool satisfied
-    success_at: list[float | None]  # k < K: on the first test_scenes scenes; k = K: the whole pool
-    success_physics: float | None = None
-    physics_disagreements: int | None = None
-    test_scenes: int  # scored at every k
-    test_pool: int = 0  # scored at k = K besides them
-    test_excluded: int  # of the scenes scored at k = K: infeasible for the hidden intention, not scored
-    test_scored: int | None = None  # of the scenes scored at k = K: feasible, so scored
-    signals_used: int
-    answers: dict[str, int] = Field(default_factory=dict)
-    rounds_used: int
-    done_at: int | None = None  # first signal count at which the learner said "done"
-    final_z: str = ""  # the learner's final z and goal on test scene final_scene: the first that
-    final_goal: str = ""  # can show the hidden intention (scene 0 when none can)
-    final_scene: int | None = None
-    retriever: str | None = None
-    variant: str | None = None
-    llm_calls: int = 0
-    prompt_tokens: int = 0
-    completion_tokens: int = 0
-    wall_s: float = 0.0
-    time_split: dict[str, float] = Field(default_factory=dict)
-    tests: list[TestLog] = Field(default_factory=list)
-    learner_stats: dict = Field(default_factory=dict)
-    diagnostics: dict = Field(default_factory=dict)  # the learner's, per answer (bits, kinds, top z)
-    user: dict = Field(default_factory=dict)
-    error: str | None = None
-    config: dict = Field(default_factory=dict)
-    provenance: dict = Field(default_factory=dict)  # provenance.py: code, versions, CPU, date
 
 
 def first_feasible(intention: Intention, tests: list[tuple[Scene, int]]) -> int:

@@ -36,7 +36,7 @@ class ErrorRecord(BaseModel):
 def _result_model() -> type[BaseModel]:
     """A results line of a finished episode: its EpisodeResult (without the per-scene tests)
     plus the bench's trial. Strict: a number written as a string is not a number."""
-    from activeintent.episode import EpisodeResult  # heavy: only when a file is read
+    from activeintent.records import EpisodeResult
 
     class ResultRecord(EpisodeResult):
         model_config = ConfigDict(strict=True, extra="allow")
