@@ -6,7 +6,7 @@
 
 import sys
 
-from activeintent.act.base import make_executor
+from activeintent.act.executors import make_executor
 from activeintent.envs import make_env
 from activeintent.episode import Episode, EpisodeConfig, EpisodeSeeds
 from activeintent.learners.registry import LearnerContext, get_method

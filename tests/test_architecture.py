@@ -125,8 +125,6 @@ def import_cycles(graph: dict[str, set[str]]) -> set[frozenset[str]]:
 KNOWN_IMPORT_CYCLES: frozenset[frozenset[str]] = frozenset({
     # signals/base.register_builtin(), run when base loads, imports the built-in signals; they import base
     frozenset({"activeintent.signals.base", "activeintent.signals.preference", "activeintent.signals.stop"}),
-    # act/base imports the executors inside make_executor (and the parser's fallback); they import base
-    frozenset({"activeintent.act.base", "activeintent.act.cap", "activeintent.act.parse", "activeintent.act.plan"}),
     # bench/runner imports execute_ray inside a function; the backends import runner's
     # protocol_fields and run_item inside functions
     frozenset({"activeintent.bench.runner", "activeintent.bench.backends"}),

@@ -7,7 +7,7 @@ import json
 
 import pytest
 
-from activeintent.act.base import make_executor
+from activeintent.act.executors import make_executor
 from activeintent.envs.symbolic import SymbolicEnv
 from activeintent.episode import Episode, EpisodeConfig
 from activeintent.learners.registry import LearnerContext, get_method

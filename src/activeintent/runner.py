@@ -109,8 +109,9 @@ def check_options(options: RunOptions) -> None:
     if method.needs_llm and options.llm == "none":
         raise ValueError(f"--method {options.method} needs a language model; --llm none is only for methods "
                          "that need none (bayes-*, zero-signal, random-query*).")
-    if options.executor not in ("parse", "plan", "cap"):
-        raise ValueError(f"Unknown executor {options.executor!r}; valid executors: parse, plan, cap.")
+    from activeintent.act.executors import EXECUTORS
+
+    EXECUTORS.check(options.executor)
 
 
 def build_episode(
@@ -123,7 +124,7 @@ def build_episode(
 ) -> Episode:
     """Everything before the loop starts. Errors in the options are raised here, before any work.
     ``show_final``: see :class:`Episode` (the web study's final attempt; None for every run)."""
-    from activeintent.act.base import make_executor
+    from activeintent.act.executors import make_executor
     from activeintent.envs import make_env
     from activeintent.learners.registry import LearnerContext, get_method
     from activeintent.suites import resolve as resolve_intention

@@ -16,8 +16,8 @@ import pytest
 from act_helpers import SECRET_VALUE, TEST_LIMITS, descendants, require_namespaces
 
 from activeintent.act import isolation
-from activeintent.act.base import make_executor
 from activeintent.act.cap import CapExecutor
+from activeintent.act.executors import make_executor
 from activeintent.act.isolation import (
     IsolationStatus,
     SandboxUnavailable,

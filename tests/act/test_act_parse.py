@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from activeintent.act.base import make_executor
+from activeintent.act.executors import make_executor
 from activeintent.act.parse import ParseError, parse_instruction
 from activeintent.world import (
     ALL_OBJECTS,

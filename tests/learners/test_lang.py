@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from activeintent.act.base import make_executor
+from activeintent.act.executors import make_executor
 from activeintent.envs.symbolic import SymbolicEnv
 from activeintent.episode import Episode, EpisodeConfig
 from activeintent.goals import planner

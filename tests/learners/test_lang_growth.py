@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from activeintent.act.base import make_executor
+from activeintent.act.executors import make_executor
 from activeintent.envs.symbolic import SymbolicEnv
 from activeintent.episode import Episode, EpisodeConfig
 from activeintent.goals.language import MAX_CLAUSES, Each, Goal, parse_goal

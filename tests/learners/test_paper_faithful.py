@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from chat_server import GOALS, PROGRAM, ChatServer, schema_name
 
-from activeintent.act.base import ExecutionFailure
+from activeintent.act.failures import ExecutionFailure
 from activeintent.learners.base import Estimate, RoundRecord
 from activeintent.learners.paper.faithful import (
     FaithfulConfig,

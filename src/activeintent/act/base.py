@@ -18,68 +18,13 @@ from abc import ABC, abstractmethod
 from functools import cache
 from importlib.resources import files
 from string import Template
-from typing import Any, Literal
+from typing import Any
 
-from pydantic import BaseModel, Field
-
+from activeintent.act.failures import ExecutionFailure, PlanResult, check_plan
+from activeintent.act.parse import ParseError, parse_instruction
 from activeintent.llm.base import ChatModel
-from activeintent.world.predict import apply_plan
-from activeintent.world.skills import Skill, describe_plan, describe_skill
+from activeintent.world.skills import describe_plan
 from activeintent.world.state import WorldState
-
-Stage = Literal["parse", "plan", "program", "skill"]
-EXECUTOR_NAMES = ("parse", "plan", "cap")
-
-
-class ExecutionFailure(BaseModel):
-    """Why y could not become (all of) τ: which stage failed, a one-line reason, details."""
-
-    stage: Stage
-    message: str
-    details: dict[str, Any] = Field(default_factory=dict)
-
-    def feedback_text(self) -> str:
-        """What the learner is told (the original code's wording, plus the reason)."""
-        return (
-            "I failed to generate the goal; please generate a simpler goal similar to the "
-            f"previous one. Reason ({self.stage}): {self.message}"
-        )
-
-
-class PlanResult(BaseModel):
-    """The plan for y, the failure if any, and which executor produced it.
-
-    A ``skill`` failure comes with the full plan: the steps that can be done still run.
-    """
-
-    plan: list[Skill] = Field(default_factory=list)
-    failure: ExecutionFailure | None = None
-    source: str
-    program: str | None = None  # the model's program or JSON answer, for logs
-    said: list[str] = Field(default_factory=list)
-
-    @property
-    def ok(self) -> bool:
-        return self.failure is None
-
-
-def check_plan(plan: list[Skill], state: WorldState) -> ExecutionFailure | None:
-    """A ``skill`` failure listing every step the symbolic world model says cannot be done."""
-    _, failures = apply_plan(state, plan)
-    failed = [
-        {"index": i, "skill": describe_skill(step), "reason": f.reason}
-        for i, (step, f) in enumerate(zip(plan, failures, strict=True))
-        if f is not None
-    ]
-    if not failed:
-        return None
-    first = failed[0]
-    more = f" (and {len(failed) - 1} more failed steps)" if len(failed) > 1 else ""
-    return ExecutionFailure(
-        stage="skill",
-        message=f"step {first['index'] + 1} '{first['skill']}' cannot be done: {first['reason']}{more}",
-        details={"failed_steps": failed},
-    )
 
 
 @cache
@@ -106,8 +51,6 @@ class Executor(ABC):
         self.transcript: list[dict[str, Any]] = []
 
     def to_plan(self, instruction: str, state: WorldState) -> PlanResult:
-        from activeintent.act.parse import ParseError, parse_instruction
-
         text = " ".join(str(instruction).split())  # free-form y may span lines
         if not text:
             return PlanResult(source=self.name, failure=ExecutionFailure(stage="parse", message="the instruction is empty"))
@@ -151,27 +94,3 @@ class Executor(ABC):
     @abstractmethod
     def _from_model(self, instruction: str, state: WorldState) -> PlanResult:
         """The plan for y from one model call (uses ``self.model``)."""
-
-
-def make_executor(name: str, model: ChatModel | None = None, *, parser_first: bool = False, **options: Any) -> Executor:
-    """The executor for ``--executor NAME`` (parse, plan or cap).
-
-    ``plan`` and ``cap`` call their model for every y; ``parser_first=True`` (the structured
-    variant) lets canonical y skip the model. Without a model, ``plan`` and ``cap`` read only
-    the canonical phrasing (like ``parse``) and report anything else as a parse failure;
-    methods that plan by themselves need no model.
-    """
-    key = name.strip().lower()
-    if key == "parse":
-        from activeintent.act.parse import ParseExecutor
-
-        return ParseExecutor(model=None)
-    if key == "plan":
-        from activeintent.act.plan import PlanExecutor
-
-        return PlanExecutor(model, parser_first=parser_first, **options)
-    if key == "cap":
-        from activeintent.act.cap import CapExecutor
-
-        return CapExecutor(model, parser_first=parser_first, **options)
-    raise ValueError(f"unknown executor {name!r}; valid executors: {', '.join(EXECUTOR_NAMES)}")

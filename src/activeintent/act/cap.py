@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import re
 
-from activeintent.act.base import ExecutionFailure, Executor, PlanResult, render_prompt
+from activeintent.act.base import Executor, render_prompt
+from activeintent.act.failures import ExecutionFailure, PlanResult
 from activeintent.act.isolation import require_isolation
 from activeintent.act.sandbox import Sandbox, default_sandbox
 from activeintent.llm.base import ChatModel, Message, ModelError

@@ -26,7 +26,7 @@ def run_bench(n_programs: int = 20, seed: int = 0) -> dict:
 
     import numpy as np
 
-    from activeintent.act.base import check_plan
+    from activeintent.act.failures import check_plan
     from activeintent.act.parse import parse_instruction
     from activeintent.act.plan import answer_to_plan, plan_schema
     from activeintent.act.robot_api import RobotAPI

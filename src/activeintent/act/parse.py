@@ -14,7 +14,7 @@ import re
 from collections.abc import Sequence
 from typing import Literal
 
-from activeintent.act.base import ExecutionFailure, Executor, PlanResult
+from activeintent.act.failures import ExecutionFailure
 from activeintent.act.robot_api import position_key
 from activeintent.world.scene import kind_of
 from activeintent.world.skills import PutAt, PutIn, PutNextTo, PutOn, Skill
@@ -139,12 +139,3 @@ def parse_instruction(text: str, objects: Sequence[str] | WorldState) -> list[Sk
             kind="unknown_object", details={"unknown": missing, "objects": names},
         )
     return plan
-
-
-class ParseExecutor(Executor):
-    """``--executor parse``: the canonical phrasing only, no model."""
-
-    name = "parse"
-
-    def _from_model(self, instruction: str, state: WorldState) -> PlanResult:  # pragma: no cover
-        raise AssertionError("the parse executor has no model")

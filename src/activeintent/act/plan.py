@@ -12,7 +12,8 @@ from typing import Any, Literal, Union
 
 from pydantic import BaseModel, Field, TypeAdapter, ValidationError, create_model
 
-from activeintent.act.base import ExecutionFailure, Executor, PlanResult, render_prompt
+from activeintent.act.base import Executor, render_prompt
+from activeintent.act.failures import ExecutionFailure, PlanResult
 from activeintent.llm.base import ChatModel, ModelError
 from activeintent.world.relations import describe_state
 from activeintent.world.skills import TABLE_POSITIONS, Skill
