@@ -123,8 +123,6 @@ def import_cycles(graph: dict[str, set[str]]) -> set[frozenset[str]]:
 # later issue; remove an entry when its cycle is broken (the test below fails while a listed
 # cycle no longer exists, so this list only shrinks). Any cycle not listed here fails.
 KNOWN_IMPORT_CYCLES: frozenset[frozenset[str]] = frozenset({
-    # signals/base.register_builtin(), run when base loads, imports the built-in signals; they import base
-    frozenset({"activeintent.signals.base", "activeintent.signals.preference", "activeintent.signals.stop"}),
     # bench/runner imports execute_ray inside a function; the backends import runner's
     # protocol_fields and run_item inside functions
     frozenset({"activeintent.bench.runner", "activeintent.bench.backends"}),

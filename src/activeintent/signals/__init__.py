@@ -7,13 +7,7 @@ trajectories) and ``stop`` (the time the person pressed stop, or none). Add your
 ``SIGNALS.register("name", YourSignal)`` — see ``examples/my_signal.py``.
 """
 
-from activeintent.signals.base import (
-    SIGNALS,
-    Answer,
-    Judge,
-    Signal,
-    answer_kind_from_dump,
-    get_signal,
-)
+from activeintent.signals.base import Answer, Judge, Signal
+from activeintent.signals.registry import SIGNALS, answer_kind_from_dump, get_signal
 
 __all__ = ["SIGNALS", "Answer", "Judge", "Signal", "answer_kind_from_dump", "get_signal"]

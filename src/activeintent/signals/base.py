@@ -9,9 +9,8 @@ from collections.abc import Iterator
 from typing import ClassVar, Protocol
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, ValidationError
+from pydantic import BaseModel, ConfigDict
 
-from activeintent.registry import Registry
 from activeintent.world.state import WorldState
 from activeintent.world.trajectory import Trajectory
 
@@ -41,22 +40,6 @@ class Answer(BaseModel):
 
     def _kind(self) -> str:
         return self.signal
-
-
-def answer_kind_from_dump(d: dict) -> str:
-    """``Answer.kind`` of an answer as stored (by its signal's answer model; records of a
-    signal not registered in this process: new_scene or the signal's name)."""
-    if d.get("new_scene"):
-        return "new_scene"
-    name = d.get("signal")
-    if not isinstance(name, str):
-        return "?"
-    if name in SIGNALS:
-        try:
-            return get_signal(name).Answer.model_validate(d).kind
-        except ValidationError:
-            pass
-    return name
 
 
 class Judge(Protocol):
@@ -111,17 +94,3 @@ class Signal(ABC):
         values must be the same)."""
         for shown in queries:
             yield self.predictive(shown, judge, model)
-
-
-SIGNALS: Registry[Signal] = Registry("signal")
-
-
-def get_signal(name: str) -> Signal:
-    return SIGNALS.make(name)
-
-
-def register_builtin() -> None:
-    from activeintent.signals import preference, stop  # noqa: F401 - registers them
-
-
-register_builtin()

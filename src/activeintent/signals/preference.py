@@ -18,7 +18,7 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from activeintent.signals.base import SIGNALS, Answer, Judge, Signal
+from activeintent.signals.base import Answer, Judge, Signal
 from activeintent.world.state import WorldState
 from activeintent.world.trajectory import Trajectory
 
@@ -130,6 +130,3 @@ class PreferenceSignal(Signal):
         # One uniform draw per answer (also for the exact user) keeps random streams aligned.
         k = int(np.searchsorted(np.cumsum(p), rng.random() * p.sum(), side="right"))
         return PreferenceAnswer(choice=CHOICES[min(k, 2)])  # type: ignore[arg-type]
-
-
-SIGNALS.register("preference", PreferenceSignal, help="A / B / can't choose between two trajectories")

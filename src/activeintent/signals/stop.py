@@ -17,7 +17,7 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from activeintent.signals.base import SIGNALS, Answer, Signal
+from activeintent.signals.base import Answer, Signal
 from activeintent.world.trajectory import Trajectory
 
 EXPORT_FPS = 10  # videos are exported at 10 frames per second: frame = floor(t · fps)
@@ -164,6 +164,3 @@ class StopSignal(Signal):
         lapse = np.full(n + 1, model.lapse / (2 * n))  # as in likelihood: half stop somewhere, half no stop
         lapse[n] = model.lapse / 2
         return (1 - model.lapse) * p + lapse
-
-
-SIGNALS.register("stop", StopSignal, help="the time the person pressed stop while the robot worked, or none")
