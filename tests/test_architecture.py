@@ -126,9 +126,6 @@ KNOWN_IMPORT_CYCLES: frozenset[frozenset[str]] = frozenset({
     # bench/runner imports execute_ray inside a function; the backends import runner's
     # protocol_fields and run_item inside functions
     frozenset({"activeintent.bench.runner", "activeintent.bench.backends"}),
-    # the registry's lang-* entries import lang/learner lazily; its lang_method imports the
-    # registry's LearnerContext and Method inside the function
-    frozenset({"activeintent.learners.registry", "activeintent.learners.lang.learner"}),
 })
 
 

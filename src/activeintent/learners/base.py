@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from pydantic import BaseModel, Field
 
+from activeintent.llm.base import ChatModel
 from activeintent.signals import Answer
 from activeintent.world import Scene, Skill, WorldState
 from activeintent.world.trajectory import Trajectory
@@ -84,3 +87,32 @@ class Learner(ABC):
     @abstractmethod
     def final(self, scene: Scene, state: WorldState) -> Estimate:
         """The current z and one y for a test scene (called after every signal)."""
+
+
+@dataclass
+class LearnerContext:
+    """Everything a method may need to build its learner (from the run's options)."""
+
+    llm: ChatModel | None = None
+    vlm: ChatModel | None = None
+    retriever: str = "symbolic"
+    seed: int = 0
+    design_scenes: bool = True
+    epsilon: float = 2.0
+    prior: str = "length"
+    variant: str = "faithful"  # the paper's methods: faithful (as the paper ran them) | structured
+    early_threshold: float | None = None  # eq. 3: a stop before this many seconds shows no I_b (None: ε)
+
+
+@dataclass
+class Method:
+    signal: str
+    needs_llm: bool
+    build: Callable[[LearnerContext], Learner]
+    help: str = ""
+    family: str = "ours"  # paper | ours | baseline
+
+    def __call__(self, ctx: LearnerContext) -> Learner:
+        if self.needs_llm and ctx.llm is None:
+            raise ValueError("this method needs a language model (--llm embedded, gguf:…, openai:…)")
+        return self.build(ctx)

@@ -7,41 +7,9 @@ learner with ``METHODS.register("name", Method(...))`` in a file passed with ``-
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 
-from activeintent.learners.base import Learner
-from activeintent.llm.base import ChatModel
+from activeintent.learners.base import Learner, LearnerContext, Method
 from activeintent.registry import Registry, UnknownName
-
-
-@dataclass
-class LearnerContext:
-    """Everything a method may need to build its learner (from the run's options)."""
-
-    llm: ChatModel | None = None
-    vlm: ChatModel | None = None
-    retriever: str = "symbolic"
-    seed: int = 0
-    design_scenes: bool = True
-    epsilon: float = 2.0
-    prior: str = "length"
-    variant: str = "faithful"  # the paper's methods: faithful (as the paper ran them) | structured
-    early_threshold: float | None = None  # eq. 3: a stop before this many seconds shows no I_b (None: ε)
-
-
-@dataclass
-class Method:
-    signal: str
-    needs_llm: bool
-    build: Callable[[LearnerContext], Learner]
-    help: str = ""
-    family: str = "ours"  # paper | ours | baseline
-
-    def __call__(self, ctx: LearnerContext) -> Learner:
-        if self.needs_llm and ctx.llm is None:
-            raise ValueError("this method needs a language model (--llm embedded, gguf:…, openai:…)")
-        return self.build(ctx)
-
 
 METHODS: Registry[Method] = Registry("method")
 

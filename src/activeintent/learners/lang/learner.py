@@ -18,7 +18,7 @@ from activeintent import ranking
 from activeintent.goals import planner
 from activeintent.goals.facts import Facts, facts
 from activeintent.goals.language import Goal
-from activeintent.learners.base import RoundRecord
+from activeintent.learners.base import LearnerContext, Method, RoundRecord
 from activeintent.learners.bayes.candidates import predict
 from activeintent.learners.bayes.judge import HypothesisJudge, trajectory_steps, utility
 from activeintent.learners.bayes.learner import BayesConfig, BayesLearner
@@ -222,8 +222,6 @@ DECIDE = {"scenes": "belief", "gain": "decision", "needs": True}
 def lang_method(signal: str, prefix: str = "lang"):
     """The registry entry of ``lang-<signal>`` or ``decide-<signal>`` (built from a
     LearnerContext like ``bayes``)."""
-    from activeintent.learners.registry import LearnerContext, Method
-
     settings = DECIDE if prefix == "decide" else {}
 
     def build(ctx: LearnerContext) -> LangLearner:
