@@ -1,5 +1,5 @@
 """The layering the design promises, checked on the source: data flows one way, learners and
-users never see each other, nothing above world/ imports the simulator, no import cycles beyond the known ones (KNOWN_IMPORT_CYCLES)."""
+users never see each other, nothing above world/ imports the simulator, no import cycles."""
 
 from __future__ import annotations
 
@@ -118,18 +118,12 @@ def import_cycles(graph: dict[str, set[str]]) -> set[frozenset[str]]:
     return cycles
 
 
-# Import cycles that exist today, closed only by lazy (function-level) imports or by imports
-# that run at load time (a registry filling itself). They are known debt, to be removed by a
-# later issue; remove an entry when its cycle is broken (the test below fails while a listed
-# cycle no longer exists, so this list only shrinks). Any cycle not listed here fails.
-KNOWN_IMPORT_CYCLES: frozenset[frozenset[str]] = frozenset({
-    # bench/runner imports execute_ray inside a function; the backends import runner's
-    # protocol_fields and run_item inside functions
-    frozenset({"activeintent.bench.runner", "activeintent.bench.backends"}),
-})
+# Import cycles allowed (none since issue 30: a registry lives in its own module, not in the
+# base its entries import). Lazy (function-level) imports count as imports.
+KNOWN_IMPORT_CYCLES: frozenset[frozenset[str]] = frozenset()
 
 
-def test_no_import_cycles_beyond_the_known_ones():
+def test_no_import_cycles():
     cycles = import_cycles(import_graph())
     new = [sorted(c) for c in cycles - KNOWN_IMPORT_CYCLES]
     assert not new, f"new import cycles (function-level imports count): {new}"

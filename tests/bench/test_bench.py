@@ -15,7 +15,8 @@ from pathlib import Path
 import pytest
 
 from activeintent.bench.report import wilson, write_report
-from activeintent.bench.runner import BenchOptions, run_bench
+from activeintent.bench.runner import run_bench
+from activeintent.bench.work import BenchOptions
 from activeintent.protocol import FORMAT_VERSION, trial_seeds
 from activeintent.results import read_results
 from activeintent.runner import RunOptions

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from activeintent.bench.runner import BenchOptions, run_bench
+from activeintent.bench.runner import run_bench
+from activeintent.bench.work import BenchOptions
 from activeintent.results import read_results
 from activeintent.runner import RunOptions
 

@@ -300,7 +300,7 @@ def test_k_rounds_run_whatever_the_model_says(tmp_path, monkeypatch):
 
 def test_trials_are_independent_draws_and_replay_exactly(tmp_path, monkeypatch):
     require_sandbox()
-    from activeintent.bench.runner import WorkItem, run_item
+    from activeintent.bench.work import WorkItem, run_item
 
     monkeypatch.setenv("OPENAI_API_KEY", "test")
     cache = tmp_path / "cache.sqlite"
@@ -352,7 +352,8 @@ def test_bench_preset_table1_runs_the_papers_methods_beside_its_rows(tmp_path, m
 
 
 def test_resuming_a_folder_made_before_variants_existed(tmp_path):
-    from activeintent.bench.runner import BenchOptions, _check_same_settings
+    from activeintent.bench.runner import _check_same_settings
+    from activeintent.bench.work import BenchOptions
 
     old = BenchOptions(methods=["bayes-stop"], intentions=["stack"], run=RunOptions(video="none"))
     data = json.loads(old.model_dump_json())

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from activeintent.bench.runner import BenchOptions, WorkItem
+    from activeintent.bench.work import BenchOptions, WorkItem
 
 BACKENDS = ("local", "ray")
 
@@ -44,7 +44,7 @@ def check_backend(name: str) -> None:
 
 def worker_died(item: WorkItem, options: BenchOptions, why: str = "worker process died") -> dict:
     """The record of an episode whose worker ended without an answer (e.g. a native crash)."""
-    from activeintent.bench.runner import protocol_fields
+    from activeintent.bench.work import protocol_fields
 
     return {"method": item.method, "intention": item.intention, "trial": item.trial,
             **protocol_fields(options.run), "success": None, "error": why}
@@ -83,7 +83,7 @@ def execute_ray(todo: list[WorkItem], options: BenchOptions, out: Path) -> Itera
     import ray
     from ray.exceptions import RayError, RayTaskError
 
-    from activeintent.bench.runner import run_item
+    from activeintent.bench.work import run_item
 
     if not todo:
         return

@@ -80,7 +80,8 @@ def bench(
 
     from activeintent.bench.backends import check_backend
     from activeintent.bench.report import plot_success_vs_signals, write_report
-    from activeintent.bench.runner import BenchOptions, protocol_fields, run_bench
+    from activeintent.bench.runner import run_bench
+    from activeintent.bench.work import BenchOptions, protocol_fields
     from activeintent.runner import check_options
     from activeintent.suites import resolve
     from activeintent.suites import suite as suite_names

@@ -68,7 +68,7 @@ def sample_records(records: list[dict], sample: int) -> list[dict]:
 
 def verify(folder: Path, sample: int, methods: list[str] | None = None) -> list[dict]:
     """Differences between recorded and re-run episodes (empty when they agree)."""
-    from activeintent.bench.runner import BenchOptions, WorkItem, run_item
+    from activeintent.bench.work import BenchOptions, WorkItem, run_item
     from activeintent.results import read_results
 
     note = folder / NOT_VERIFIED
