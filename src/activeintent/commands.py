@@ -20,12 +20,12 @@ def methods() -> None:
     from rich.console import Console
     from rich.table import Table
 
-    from activeintent.learners.registry import METHODS, get_method
+    from activeintent.learners.registry import get_method, method_names
 
     table = Table(title="methods")
     for col in ("method", "family", "signal", "needs a model", "what it does"):
         table.add_column(col, overflow="fold")
-    for name in METHODS.names():
+    for name in method_names():
         m = get_method(name)
         table.add_row(name, m.family, m.signal, "yes" if m.needs_llm else "no", m.help)
     Console().print(table)

@@ -109,14 +109,21 @@ PAPER_METHODS = ("preference", "mllm", "mllm-llm")
 BASELINES = ("zero-signal", "random-query", "random-query-preference")
 
 
+def _derived() -> dict[str, str]:
+    """``bayes-<signal>`` for every registered signal without a method of that name (derived
+    when asked, never registered: plug-in signals added later get theirs too)."""
+    from activeintent.signals import SIGNALS
+
+    return {f"bayes-{s}": s for s in SIGNALS.names() if f"bayes-{s}" not in METHODS}
+
+
 def get_method(name: str) -> Method:
     """The method called ``name``; ``bayes-<signal>`` for any registered signal."""
-    if name not in METHODS and name.startswith("bayes-"):
-        from activeintent.signals import SIGNALS
-
-        signal = name.removeprefix("bayes-")
-        if signal in SIGNALS:
-            METHODS.register(name, lambda: Method(signal, False, _bayes(signal), f"ours, for the {signal} signal"))
+    signal = _derived().get(name) if name not in METHODS else None
+    if signal is not None:
+        return Method(signal, False, _bayes(signal), f"ours, for the {signal} signal")
+    if name not in METHODS:  # the error lists the derived names too
+        raise UnknownName(f"Unknown method {name!r}; valid methods: {', '.join(method_names())}.")
     return METHODS.make(name)
 
 
@@ -126,7 +133,7 @@ def check_method(name: str) -> str:
 
 
 def method_names() -> list[str]:
-    return METHODS.names()
+    return METHODS.names() + list(_derived())
 
 
 def make_learner(name: str, ctx: LearnerContext) -> Learner:
