@@ -395,7 +395,11 @@ def test_a_pool_that_cannot_start_is_tried_once(demo, tmp_path):
     script.write_text(
         "import multiprocessing, pickle\nimport activeintent.sim.render as r\n"
         "from activeintent.sim.video import frame_times\n"
+        "from multiprocessing import resource_tracker\n"
         "if __name__ == '__main__':\n"
+        # the tracker must start on the real interpreter: one that exits at once makes the
+        # first lock's registration race a closed pipe (BrokenPipeError under load)
+        "    resource_tracker.ensure_running()\n"
         "    multiprocessing.set_executable('/bin/false')\n"
         "    tries = []\n    start = r._render_pool\n    r._render_pool = lambda w: tries.append(w) or start(w)\n"
         "    first = r.warm_render_pool(2)\n"
