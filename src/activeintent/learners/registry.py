@@ -119,12 +119,12 @@ def _derived() -> dict[str, str]:
 
 def get_method(name: str) -> Method:
     """The method called ``name``; ``bayes-<signal>`` for any registered signal."""
-    signal = _derived().get(name) if name not in METHODS else None
-    if signal is not None:
-        return Method(signal, False, _bayes(signal), f"ours, for the {signal} signal")
-    if name not in METHODS:  # the error lists the derived names too
+    if name in METHODS:
+        return METHODS.make(name)
+    signal = _derived().get(name)
+    if signal is None:  # the error lists the derived names too
         raise UnknownName(f"Unknown method {name!r}; valid methods: {', '.join(method_names())}.")
-    return METHODS.make(name)
+    return Method(signal, False, _bayes(signal), f"ours, for the {signal} signal")
 
 
 def check_method(name: str) -> str:

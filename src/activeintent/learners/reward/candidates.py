@@ -19,7 +19,7 @@ from activeintent import ranking
 from activeintent.envs.symbolic import symbolic_trajectory
 from activeintent.goals.facts import facts, state_key
 from activeintent.learners.bayes.candidates import Outcome
-from activeintent.learners.reward.features import phi
+from activeintent.learners.reward.features import N_FEATURES, phi
 from activeintent.world import PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState, apply_skill
 from activeintent.world.skills import TABLE_POSITIONS
 
@@ -166,7 +166,7 @@ def successor_features(state: WorldState, memo: dict | None = None) -> np.ndarra
     got = memo.get(key) if memo is not None else None
     if got is None:
         succ = successors(state)
-        got = np.array([phi(s) for _, s in succ]) if succ else np.zeros((0, len(phi(state))))
+        got = np.array([phi(s) for _, s in succ]) if succ else np.zeros((0, N_FEATURES))
         if memo is not None:
             memo[key] = got
     return got
