@@ -6,6 +6,11 @@ Nothing in the package is edited: this file registers the signal, and the method
     bin/activeintent bench --plugin examples/my_signal.py --methods bayes-rating,zero-signal \\
         --suite paper --trials 2 --env symbolic --llm none --out runs/rating
 
+People give it too: its page is ``my_signal.html`` beside this file (what the browser shows and
+posts), and ``from_web`` reads what the page posts. Serve a study with it:
+
+    bin/activeintent serve --plugin examples/my_signal.py --method bayes-rating --intention color-match
+
 Observation model: the rating centres on 1 + 4·u(s), u ∈ [0, 1] the outcome's utility under
 the intention z, with Gaussian noise of ``noise`` stars, mixed with a lapse λ.
 """
@@ -17,7 +22,7 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from activeintent.signals import SIGNALS, Answer, Signal
+from activeintent.signals import SIGNALS, Answer, AnswerRejected, ShownRound, Signal, WebForm
 
 STARS = np.arange(1, 6)
 
@@ -28,6 +33,14 @@ class RatingAnswer(Answer):
 
     def _describe(self) -> str:
         return f"the user rated the robot's work {self.stars} of 5 stars"
+
+
+class RatingForm(WebForm):
+    """What my_signal.html posts: the stars, or a new scene."""
+
+    kind: Literal["rating"]
+    stars: int | None = Field(None, ge=1, le=5)
+    new_scene: bool = False
 
 
 class RatingModel(BaseModel):
@@ -42,6 +55,15 @@ class RatingSignal(Signal):
     shows = 1
     Answer = RatingAnswer
     Model = RatingModel
+    page = "my_signal.html"
+    WebForm = RatingForm
+
+    def from_web(self, form: RatingForm, shown: ShownRound) -> RatingAnswer:
+        if form.new_scene:
+            return self.new_scene()
+        if form.stars is None:
+            raise AnswerRejected("a rating needs 'stars' (1 to 5), or 'new_scene': true", status=422)
+        return RatingAnswer(stars=form.stars)
 
     def predictive(self, shown, judge, model: RatingModel) -> np.ndarray:
         (traj,) = shown

@@ -1,5 +1,6 @@
-"""HumanUser: the hand-over between the episode's thread and the person's answers, and the
-mapping of a stop in the video to the trajectory (the same h a simulated stop user gives)."""
+"""HumanUser: the hand-over between the episode's thread and the person's answers; and the stop
+signal's reading of its page's answer: a stop in the video mapped to the trajectory (the same h
+a simulated stop user gives)."""
 
 from __future__ import annotations
 
@@ -8,16 +9,11 @@ import threading
 import numpy as np
 import pytest
 
+from activeintent.signals import AnswerRejected, ShownRound
 from activeintent.signals.preference import PreferenceAnswer
-from activeintent.signals.stop import StopAnswer
-from activeintent.users.human import (
-    AnswerRejected,
-    HumanUser,
-    SessionCancelled,
-    stop_answer,
-    video_duration,
-    video_frames,
-)
+from activeintent.signals.stop import StopAnswer, StopForm, StopSignal
+from activeintent.users.human import HumanUser, SessionCancelled
+from activeintent.web.session import video_duration, video_frames
 from activeintent.world import PutIn, Scene, WorldState
 from activeintent.world.trajectory import StepRecord, Trajectory
 
@@ -47,6 +43,13 @@ def _trajectory(n_ticks: int = 181, dt: float = 1 / 60) -> Trajectory:
 
 
 SCENE = Scene(objects=["red block", "red bowl", "blue block"])
+
+
+def stop_answer(traj: Trajectory, t: float, fps: int) -> StopAnswer:
+    """h the stop signal reads from its page's stop at media time t (first viewing, not ended);
+    built without the form's own checks, so the signal's are the ones tested."""
+    form = StopForm.model_construct(kind="stop", round=1, action="stop", time=t, viewing="first", client_ts=None)
+    return StopSignal().from_web(form, ShownRound([traj], [video_duration(traj, fps)], fps))
 
 
 def test_video_length_matches_frames_of_the_trajectory():

@@ -85,7 +85,7 @@ def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server,
         ({"kind": "preference", "round": 0, "choice": "A"}, 422, "greater than or equal to 1"),
         ({"kind": "preference", "round": "one", "choice": "A"}, 422, "round"),
         ({"kind": "vote", "round": 1, "choice": "A"}, 422, "'preference', 'stop'"),
-        ({"kind": "stop", "round": 1, "action": "looks_good"}, 422, "asks for preference answers"),
+        ({"kind": "stop", "round": 1, "action": "no_stop"}, 422, "asks for preference answers"),
         ({"kind": "preference", "round": 2, "choice": "A"}, 409, "waiting for round 1"),
         ([1, 2, 3], 422, "invalid request"),
     ]
@@ -140,8 +140,8 @@ def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server, ht
         assert "time" in res.json()["error"]["message"]
     for body, message in [
         ({"kind": "stop", "round": 1, "action": "stop"}, "needs 'time'"),
-        ({"kind": "stop", "round": 1, "action": "looks_good", "time": 1.0}, "takes no 'time'"),
-        ({"kind": "stop", "round": 1, "action": "halt", "time": 1.0}, "'stop', 'looks_good' or 'new_scene'"),
+        ({"kind": "stop", "round": 1, "action": "no_stop", "time": 1.0}, "takes no 'time'"),
+        ({"kind": "stop", "round": 1, "action": "halt", "time": 1.0}, "'stop', 'no_stop' or 'new_scene'"),
         ({"kind": "preference", "round": 1, "choice": "A"}, "asks for stop answers"),
     ]:
         res = http.post(answer, json=body)
@@ -165,7 +165,7 @@ def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server, ht
 
     # a finished session takes no answers; its saved data stays as it is
     done = snapshot(folder)
-    res = http.post(answer, json={"kind": "stop", "round": 2, "action": "looks_good"})
+    res = http.post(answer, json={"kind": "stop", "round": 2, "action": "no_stop"})
     assert res.status_code == 409 and "finished" in res.json()["error"]["message"]
     assert snapshot(folder) == done
 
@@ -268,7 +268,7 @@ def test_stopping_the_server_cancels_sessions_in_progress(live_server, http):
     srv.manager.shutdown(timeout=60)  # what the app's lifespan does when uvicorn stops
     session = srv.manager.get(sid)
     assert not session.active and session.status == "cancelled" and "server stopped" in session.error
-    res = http.post(f"{srv.url}/api/sessions/{sid}/answer", json={"kind": "stop", "round": 1, "action": "looks_good"})
+    res = http.post(f"{srv.url}/api/sessions/{sid}/answer", json={"kind": "stop", "round": 1, "action": "no_stop"})
     assert res.status_code == 409 and "cancelled" in res.json()["error"]["message"]
     log = [json.loads(x) for x in (srv.session_dir(sid) / "events.jsonl").read_text().splitlines()]
     assert log[-1]["type"] == "session_cancelled"
@@ -297,11 +297,11 @@ def test_request_bodies_take_exact_types_not_lookalikes(live_server):
         folder = srv.session_dir(sid)
         before = snapshot(folder)
         lookalikes = [
-            ("answer", {"kind": "stop", "round": True, "action": "looks_good"}, "round"),
-            ("answer", {"kind": "stop", "round": 1.0, "action": "looks_good"}, "round"),
-            ("answer", {"kind": "stop", "round": "1", "action": "looks_good"}, "round"),
+            ("answer", {"kind": "stop", "round": True, "action": "no_stop"}, "round"),
+            ("answer", {"kind": "stop", "round": 1.0, "action": "no_stop"}, "round"),
+            ("answer", {"kind": "stop", "round": "1", "action": "no_stop"}, "round"),
             ("answer", {"kind": "stop", "round": 1, "action": "stop", "time": True}, "time"),
-            ("answer", {"kind": "stop", "round": 1, "action": "looks_good", "client_ts": True}, "client_ts"),
+            ("answer", {"kind": "stop", "round": 1, "action": "no_stop", "client_ts": True}, "client_ts"),
             ("events", {"events": [{"type": "x", "client_ts": True}]}, "client_ts"),
             ("events", {"events": [{"type": "x", "client_ts": 1.5, "round": True}]}, "round"),
             ("video", {"round": True, "event": "ready"}, "round"),
@@ -315,7 +315,7 @@ def test_request_bodies_take_exact_types_not_lookalikes(live_server):
         assert snapshot(folder) == before, "a refused request changed the saved data"
         # whole numbers where seconds are asked for are still numbers
         ok = http.post(f"{api}/sessions/{sid}/answer",
-                       json={"kind": "stop", "round": 1, "action": "looks_good", "client_ts": 1700000000})
+                       json={"kind": "stop", "round": 1, "action": "no_stop", "client_ts": 1700000000})
         assert ok.status_code == 200, ok.text
 
 
@@ -347,7 +347,7 @@ def test_a_session_takes_answers_only_from_the_browser_that_started_it(live_serv
 
         other = stranger.post(f"{api}/sessions", json={"participant": "P-other"}).json()["id"]
         other_key = stranger.cookies.get("activeintent_key", path=f"/api/sessions/{other}")
-        looks_good = {"kind": "stop", "round": 1, "action": "looks_good"}
+        no_stop = {"kind": "stop", "round": 1, "action": "no_stop"}
         attempts = [
             (stranger, {}),  # no key at all
             (stranger, {"Cookie": "activeintent_key=" + "A" * 43}),  # a guessed one
@@ -355,7 +355,7 @@ def test_a_session_takes_answers_only_from_the_browser_that_started_it(live_serv
             (httpx, {"Cookie": f"activeintent_key={key[:-1]}"}),  # almost the right one
         ]
         for c, headers in attempts:
-            for path, body in [("answer", looks_good), ("video", {"round": 1, "event": "ready"}),
+            for path, body in [("answer", no_stop), ("video", {"round": 1, "event": "ready"}),
                                ("events", {"events": [{"type": "x", "client_ts": 1.7e9}]}),
                                ("questionnaire", {"final_attempt": "yes", "rule": "mine"}),
                                ("answer", {"kind": "stop", "round": "bad"})]:  # refused before validation
@@ -366,7 +366,7 @@ def test_a_session_takes_answers_only_from_the_browser_that_started_it(live_serv
         assert snapshot(folder) == before, "a refused request changed the saved data"
         assert stranger.get(f"{api}/sessions/{sid}").status_code == 200  # reading needs only the id
 
-        ok = owner.post(f"{api}/sessions/{sid}/answer", json=looks_good)
+        ok = owner.post(f"{api}/sessions/{sid}/answer", json=no_stop)
         assert ok.status_code == 200, ok.text
         session = srv.manager.get(sid)
         assert session.join(300) and session.status == "finished", session.error

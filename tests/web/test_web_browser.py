@@ -94,7 +94,7 @@ def near_end(page, length: float, before: float) -> None:
 def test_two_round_preference_session(live_server, page, tmp_path):
     srv = live_server("bayes-preference", rounds=2, seed=3, **VIDEO)
     sid = start(page, srv.url, "P-pref", tmp_path)
-    assert urlsplit(page.url).path == "/preference"
+    assert urlsplit(page.url).path == "/signal/preference"
 
     wait_round(page, 1)
     wait_videos(page, "video-a", "video-b")
@@ -146,7 +146,7 @@ def test_two_round_preference_session(live_server, page, tmp_path):
 def test_clicker_session_stops_at_a_known_moment(live_server, page, tmp_path):
     srv = live_server("bayes-stop", rounds=2, seed=4, **VIDEO)
     sid = start(page, srv.url, "P-stop")
-    assert urlsplit(page.url).path == "/clicker"
+    assert urlsplit(page.url).path == "/signal/stop"
     folder = srv.session_dir(sid)
 
     wait_round(page, 1)
@@ -198,7 +198,7 @@ def test_clicker_session_stops_at_a_known_moment(live_server, page, tmp_path):
     log = events(folder)
     stops = [e for e in log if e["type"] == "stop"]
     assert len(stops) == 1 and stops[0]["data"]["via"] == "key" and stops[0]["round"] == 1
-    assert [e["data"]["via"] for e in log if e["type"] == "looks_good"] == ["click"]
+    assert [e["data"]["via"] for e in log if e["type"] == "no_stop"] == ["click"]
     answers = [e for e in log if e["type"] == "answer" and e["source"] == "server"]
     assert [a["answer"] for a in answers] == [h1, h2]
 
@@ -231,7 +231,7 @@ def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server,
     enter(page, free.url + "/", "P-free")
     assert page.is_visible("#rule-free") and not page.is_visible("#rule-assigned")
     page.click("#start")
-    page.wait_for_url("**/preference?session=*")
+    page.wait_for_url("**/signal/preference?session=*")
     sid = session_id(page)
     wait_round(page, 1)
     ready(page)
@@ -273,7 +273,7 @@ def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server,
     assert page.is_visible("#rule-assigned") and not page.is_visible("#rule-free")
     assert page.inner_text("#rule-text") == "Put each block in the bowl of the same colour."
     page.click("#start")
-    page.wait_for_url("**/clicker?session=*")
+    page.wait_for_url("**/signal/stop?session=*")
     sid = session_id(page)
     wait_round(page, 1)
     ready(page)
@@ -357,7 +357,7 @@ def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
     text = page.inner_text("body").lower()
     assert "bayes" not in text and "signal" not in text and expected not in text  # no method, no condition
     page.click("#start")
-    page.wait_for_url("**/clicker?session=*")
+    page.wait_for_url("**/signal/stop?session=*")
     sid = session_id(page)
     api = f"{srv.url}/api/sessions/{sid}"
     session = srv.manager.get(sid)
@@ -462,3 +462,27 @@ def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
     # no stop time at or after the video's end
     for r in read_rounds(folder / "rounds.jsonl"):
         assert r["answer"]["stop_time"] is None or r["answer"]["stop_time"] < video["duration"] - 1e-9
+
+
+def test_a_plugin_signal_brings_its_own_page(live_server, page, tmp_path):
+    """examples/my_signal.py registers the rating signal with its page (examples/my_signal.html)
+    and nothing in the package changes: a participant rates in the browser, and the episode's
+    rounds hold the ratings the clicks meant."""
+    from activeintent.registry import load_plugin
+
+    load_plugin(Path(__file__).resolve().parents[2] / "examples" / "my_signal.py")
+    srv = live_server("bayes-rating", rounds=2, seed=5, **VIDEO)
+    sid = start(page, srv.url, "P-rating")
+    assert urlsplit(page.url).path == "/signal/rating"
+    wait_round(page, 1)
+    ready(page)
+    page.click('button[data-stars="4"]:enabled')
+    wait_round(page, 2)
+    ready(page)
+    page.click('button[data-new-scene="1"]:enabled')
+    page.wait_for_url("**/done?session=*")
+    session = srv.manager.get(sid)
+    assert session.join(120) and session.status == "finished", session.error
+    rounds = read_rounds(srv.session_dir(sid) / "rounds.jsonl")
+    assert [r["answer"] for r in rounds] == [{"signal": "rating", "new_scene": False, "stars": 4},
+                                             {"signal": "rating", "new_scene": True, "stars": None}]

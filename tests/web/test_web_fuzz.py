@@ -252,7 +252,7 @@ def fuzz_path(rng: random.Random, sid: str, endpoint: str) -> str:
         "result": f"/api/sessions/{s}/result",
         "questionnaire": f"/api/sessions/{s}/questionnaire",
         "files": f"/api/sessions/{s}/files/{name}",
-        "other": rng.choice(["/", "/preference", "/clicker", "/done", "/api/config", "/openapi.json",
+        "other": rng.choice(["/", "/signal/preference", "/signal/stop", "/done", "/api/config", "/openapi.json",
                              "/static/style.css", "/static/%2e%2e/server.py", "/api", "/api/",
                              "/api/sessions/", "/nothing/here", "/" + "z" * 3000, "/%ff", "/api/config?x=1"]),
     }
@@ -440,7 +440,7 @@ def test_concurrent_clients_limits_and_quota(live_server):
         with ThreadPoolExecutor(12) as pool:
             answers = list(pool.map(
                 lambda i: b.post(f"{api}/sessions/{sid}/answer",
-                                 json={"kind": "stop", "round": 1, "action": "new_scene" if i % 2 else "looks_good"}),
+                                 json={"kind": "stop", "round": 1, "action": "new_scene" if i % 2 else "no_stop"}),
                 range(12)))
         assert sorted(r.status_code for r in answers) == [200] + [409] * 11
     codes = {r.status_code for r in floods}

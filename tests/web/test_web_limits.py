@@ -62,7 +62,7 @@ def test_idle_sessions_are_cancelled_and_free_their_slots(live_server, fake_cloc
         state_a = b.get(f"{api}/sessions/{sa}").json()
         assert state_a["status"] == "cancelled" and "idle timeout" in state_a["error"]
         assert b.get(f"{api}/sessions/{sb}").json()["status"] == "waiting-for-answer"
-        late = a.post(f"{api}/sessions/{sa}/answer", json={"kind": "stop", "round": 1, "action": "looks_good"})
+        late = a.post(f"{api}/sessions/{sa}/answer", json={"kind": "stop", "round": 1, "action": "no_stop"})
         assert late.status_code == 409 and "cancelled" in error(late)["message"]
         log = [json.loads(x) for x in (srv.session_dir(sa) / "events.jsonl").read_text().splitlines()]
         assert log[-1]["type"] == "session_cancelled" and "idle" in log[-1]["reason"]

@@ -177,7 +177,7 @@ def test_free_rule_session_questionnaire_and_guess_shown_always(live_server, htt
     assert state["questionnaire"] == {"open": False, "submitted": False, "asks_final_attempt": False}
     early = http.post(q, json={"final_attempt": "yes", "rule": "mine"})
     assert early.status_code == 409 and "after the robot's final attempt" in early.json()["error"]["message"]
-    http.post(f"{api}/sessions/{sid}/answer", json={"kind": "stop", "round": 1, "action": "looks_good"})
+    http.post(f"{api}/sessions/{sid}/answer", json={"kind": "stop", "round": 1, "action": "no_stop"})
     state = _waiting(srv.url, sid, 2)
     guess = state["estimate"]
     assert guess["answers"] == 1 and guess["z"] and 0 <= guess["confidence"] <= 1  # a Bayesian learner's belief

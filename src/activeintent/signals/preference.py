@@ -18,7 +18,7 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from activeintent.signals.base import Answer, Judge, Signal
+from activeintent.signals.base import Answer, Judge, ShownRound, Signal, WebForm
 from activeintent.world.state import WorldState
 from activeintent.world.trajectory import Trajectory
 
@@ -41,6 +41,13 @@ class PreferenceAnswer(Answer):
 
     def _kind(self) -> str:
         return str(self.choice)
+
+
+class PreferenceForm(WebForm):
+    """The preference page's answer: the choice, or a new scene."""
+
+    kind: Literal["preference"]
+    choice: Literal["A", "B", "cant_choose", "new_scene"]
 
 
 class PreferenceModel(BaseModel):
@@ -85,7 +92,15 @@ class PreferenceSignal(Signal):
     shows = 2
     Answer = PreferenceAnswer
     Model = PreferenceModel
+    page_folder = "pages"
     page = "preference.html"
+    how = "preference-how.html"
+    page_assets = ("preference.js",)
+    WebForm = PreferenceForm
+    buttons = ("A", "B", "cant_choose", "new_scene")
+
+    def from_web(self, form: PreferenceForm, shown: ShownRound) -> PreferenceAnswer:
+        return self.new_scene() if form.choice == "new_scene" else PreferenceAnswer(choice=form.choice)
 
     def _probs(self, shown: list[Trajectory], judge: Judge, model: PreferenceModel) -> np.ndarray:
         if len(shown) != 2:

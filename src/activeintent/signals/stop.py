@@ -12,12 +12,12 @@ stop for no reason comes with ``false_stop`` at a uniform time; λ mixes in a un
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from activeintent.signals.base import Answer, Signal
+from activeintent.signals.base import Answer, AnswerRejected, ShownRound, Signal, WebForm
 from activeintent.world.trajectory import Trajectory
 
 EXPORT_FPS = 10  # videos are exported at 10 frames per second: frame = floor(t · fps)
@@ -43,6 +43,19 @@ class StopAnswer(Answer):
 
     def _kind(self) -> str:
         return "no_stop" if self.stop_time is None else "stop"
+
+
+class StopForm(WebForm):
+    """The stop page's answer: a stop (with the video's time), no stop, or a new scene."""
+
+    logged: ClassVar[tuple[str, ...]] = ("client_ts", "time", "viewing")
+
+    kind: Literal["stop"]
+    action: Literal["stop", "no_stop", "new_scene"]
+    time: float | None = Field(None, allow_inf_nan=False,
+                               description="for action 'stop': the video's currentTime in seconds")
+    viewing: Literal["first", "replay"] = Field(
+        "first", description="for action 'stop': during the first viewing or a replay after it")
 
 
 class StopModel(BaseModel):
@@ -92,7 +105,12 @@ class StopSignal(Signal):
     shows = 1
     Answer = StopAnswer
     Model = StopModel
-    page = "clicker.html"
+    page_folder = "pages"
+    page = "stop.html"
+    how = "stop-how.html"
+    page_assets = ("stop.js",)
+    WebForm = StopForm
+    buttons = ("no_stop", "new_scene")  # the Stop button stays where it is: a reaction, not a choice
 
     def learner_model(self) -> StopModel:
         # People react after the bad move shows, never before, with right-skewed delays: a
@@ -104,12 +122,41 @@ class StopSignal(Signal):
             raise ValueError(f"a stop query shows one trajectory τ; got {len(shown)}")
         return shown[0]
 
-    def answer_at(self, traj: Trajectory, t: float | None) -> StopAnswer:
-        """The answer for a press at time t (clipped to τ), with its tick and video frame."""
+    def answer_at(self, traj: Trajectory, t: float | None, fps: int = EXPORT_FPS) -> StopAnswer:
+        """The answer for a press at time t (clipped to τ), with its tick and the frame of τ's
+        video at ``fps`` (frame k shows time k / fps)."""
         if t is None:
             return StopAnswer()
         t = float(min(max(t, 0.0), traj.duration))
-        return StopAnswer(stop_time=t, tick=traj.tick_at(t), frame=int(math.floor(t * EXPORT_FPS + 1e-9)))
+        return StopAnswer(stop_time=t, tick=traj.tick_at(t), frame=int(math.floor(t * fps + 1e-9)))
+
+    def from_web(self, form: StopForm, shown: ShownRound) -> StopAnswer:
+        """A stop is a moment inside the video (its media time t; the last frame stays on screen
+        1/fps s past τ's end, so t maps to min(t, τ's duration)), not at or after the video's end
+        and not in a first viewing the page reported ended (a late key press)."""
+        if form.action == "new_scene":
+            if form.time is not None:
+                raise AnswerRejected("action 'new_scene' takes no 'time'", status=422)
+            return self.new_scene()
+        if form.action == "no_stop":
+            if form.time is not None:
+                raise AnswerRejected("action 'no_stop' takes no 'time'", status=422)
+            return StopAnswer()
+        t, traj, length = form.time, self._one(shown.trajectories), shown.video_lengths[0]
+        if t is None:
+            raise AnswerRejected("action 'stop' needs 'time': the video time in seconds", status=422)
+        if not math.isfinite(t) or t < 0 or t > length + 1e-6:
+            raise AnswerRejected(f"stop time {t!r} s is outside the video (valid: 0 to {length:.3f} s)", status=422)
+        if t >= length - 1e-9:
+            raise AnswerRejected(f"stop time {t:.3f} s is at or after the end of the video ({length:.3f} s): the "
+                                 "video had ended, so this is not a stop; answer no_stop or stop during a replay",
+                                 status=422, code="after_video_end")
+        if form.viewing == "first" and shown.viewing["ended"] is not None:
+            raise AnswerRejected("the first viewing of this video had ended before this stop; stop during a "
+                                 "replay (viewing: 'replay') or answer no_stop", status=422, code="after_video_end")
+        if form.viewing == "replay" and not shown.viewing["replays"]:
+            raise AnswerRejected("viewing 'replay' but no replay of this round was started", status=422)
+        return self.answer_at(traj, t, shown.fps)
 
     def sample(self, shown, judge, model: StopModel, rng) -> StopAnswer:
         traj = self._one(shown)

@@ -6,23 +6,19 @@ answers, the wait times out, or the session is cancelled. Answers come from anot
 (an HTTP request) through :meth:`HumanUser.answer`; they must name the round they answer, so a
 replayed or stale answer can never become another round's h.
 
-The clicker's stop time is mapped from the video to the trajectory exactly as a simulated stop
-user's is: video frame k shows trajectory time k / fps, so a stop at media time t (seconds) is
-the trajectory time t, its log tick ``traj.tick_at(t)``, frame ``floor(t * fps)`` and skill
-the skill index is not part of h: a person's stop is only a time.
+What the person's page posts becomes h by the signal itself (``Signal.from_web``: e.g. the stop
+signal maps a press at video time t to τ's time t, its tick and frame, as for a simulated user).
 """
 
 from __future__ import annotations
 
-import math
 import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from activeintent.signals import Answer, Signal, get_signal
-from activeintent.signals.stop import StopAnswer
+from activeintent.signals import Answer, AnswerRejected, Signal, get_signal
 from activeintent.world import Scene
 from activeintent.world.trajectory import Trajectory
 
@@ -30,15 +26,6 @@ from activeintent.world.trajectory import Trajectory
 class SessionCancelled(RuntimeError):
     """The session ended (cancelled, or the person did not answer in time) while the
     episode waited for h."""
-
-
-class AnswerRejected(ValueError):
-    """An answer that cannot be taken: ``status`` is the HTTP-like code a server should give
-    (404 nothing asked, 409 wrong round or state, 422 malformed)."""
-
-    def __init__(self, message: str, status: int = 409):
-        super().__init__(message)
-        self.status = status
 
 
 @dataclass
@@ -51,38 +38,6 @@ class Question:
     trajectories: list[Trajectory]
     presented: Any = None
     asked_at: float = field(default_factory=time.time)
-
-
-def video_frames(traj: Trajectory, fps: int) -> int:
-    """Frames of the exported video of τ: one per 1/fps s from 0, plus the last tick when the
-    duration is not a whole number of frames (``activeintent.sim.video.frame_times``)."""
-    from activeintent.sim.video import frame_times
-
-    return len(frame_times(traj, fps))
-
-
-def video_duration(traj: Trajectory, fps: int) -> float:
-    """Media length in seconds of the exported video: each frame is shown for 1/fps s."""
-    return video_frames(traj, fps) / fps
-
-
-def stop_answer(traj: Trajectory, t: float, fps: int) -> StopAnswer:
-    """h for a stop pressed at video media time ``t`` (seconds).
-
-    Raises :class:`AnswerRejected` (422) when t is not a finite time inside the video. The
-    last frame stays on screen for 1/fps s past the trajectory's end, so t is clipped to the
-    trajectory's duration for the trajectory time.
-    """
-    length = video_duration(traj, fps)
-    if not isinstance(t, int | float) or not math.isfinite(t) or t < 0 or t > length + 1e-6:
-        raise AnswerRejected(
-            f"stop time {t!r} s is outside the video (valid: 0 to {length:.3f} s)", status=422
-        )
-    stop_time = min(float(t), traj.duration)
-    return StopAnswer(stop_time=stop_time, tick=traj.tick_at(stop_time),
-                      frame=int(math.floor(stop_time * fps + 1e-9)))
-
-
 
 
 class HumanUser:

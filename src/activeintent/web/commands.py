@@ -60,7 +60,7 @@ def serve(
     max_connections_per_client: Annotated[int, typer.Option("--max-connections-per-client", min=1, help="Connections open at once from one client address (a browser uses up to 6)")] = 32,
     max_connections: Annotated[int, typer.Option("--max-connections", min=8, help="Connections open at once in all; never more than the file-descriptor limit leaves after a reserve for the sessions")] = 1000,
 ) -> None:
-    """Serve the study: participants give the preference or stop signal in the browser.
+    """Serve the study: participants give the method's signal (preference, stop, or a plug-in's with a page) in the browser.
 
     Each session is saved like a simulated run (summary.json, rounds.jsonl, videos) in OUT/<session-id>/, plus events.jsonl with every UI event. The JSON API is described at /openapi.json.
     """
@@ -72,7 +72,7 @@ def serve(
     from activeintent.suites import resolve as resolve_intention
     from activeintent.web import transport
     from activeintent.web.limits import Limits
-    from activeintent.web.server import create_app, runner_builder
+    from activeintent.web.server import create_app, page_signal, runner_builder
     from activeintent.web.session import StudyConfig
     from activeintent.web.study import StudyFileError, load_study
 
@@ -104,7 +104,7 @@ def serve(
             check_options(opt.run_options(method=m, budget=rounds, intention=rule_name,
                                           intention_file=rule_file, llm=models[name], **extra))
             rule = resolve_intention(rule_name, rule_file) if rule_name or rule_file else None
-            signal = get_method(m).signal
+            signal = page_signal(get_method(m).signal).name
         except (ValueError, IntentionError, FileNotFoundError) as err:
             where = f"condition {name}: " if study_file else ""
             raise typer.BadParameter(where + str(err)) from None

@@ -24,7 +24,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from activeintent.users.human import AnswerRejected
+from activeintent.signals import AnswerRejected
 
 log = logging.getLogger("activeintent.web")
 
@@ -111,7 +111,7 @@ def install_error_handlers(app: FastAPI) -> None:
 
     @app.exception_handler(AnswerRejected)
     async def _rejected(request: Request, exc: AnswerRejected):
-        code = {409: "conflict", 422: "invalid_answer", 503: "server_full"}.get(exc.status)
+        code = exc.code or {409: "conflict", 422: "invalid_answer", 503: "server_full"}.get(exc.status)
         return error_response(exc.status, code, str(exc))
 
     @app.exception_handler(RequestValidationError)

@@ -1,8 +1,9 @@
 """The human-in-the-loop web app: a JSON API under /api and plain HTML/JS pages.
 
-Pages: ``/`` (start), ``/preference`` (two videos, A / B / Can't choose / New scene),
-``/clicker`` (one video, Stop / Looks good / New scene) and ``/done`` (final execution, the
-end-of-session questionnaire and thank-you). Each page polls ``GET /api/sessions/{id}`` and
+Pages: ``/`` (start), ``/signal/<name>`` (the signal's own answer page, from the signal's folder:
+``preference`` shows two videos, A / B / Can't choose / New scene; ``stop`` one video, Stop /
+Looks good / New scene) and ``/done`` (final execution, the end-of-session questionnaire and
+thank-you). Each page polls ``GET /api/sessions/{id}`` and
 answers with ``POST /api/sessions/{id}/answer`` naming the round it answers; the done page sends
 ``POST /api/sessions/{id}/questionnaire``.
 """
@@ -16,7 +17,7 @@ import time
 from collections.abc import Callable
 from contextlib import asynccontextmanager
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, Union
 
 from fastapi import Depends, FastAPI, Request, Response
 from fastapi.concurrency import run_in_threadpool
@@ -24,9 +25,10 @@ from fastapi.responses import FileResponse, StreamingResponse
 from fastapi.staticfiles import StaticFiles
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
+from activeintent.signals import SIGNALS, AnswerRejected, Signal, WebForm, get_signal
 from activeintent.signals import Answer as SignalAnswer
-from activeintent.signals import get_signal
-from activeintent.users.human import AnswerRejected, Question, stop_answer
+from activeintent.signals.base import MAX_ROUND
+from activeintent.users.human import Question
 from activeintent.web.errors import ApiError, install_error_handlers
 from activeintent.web.limits import BodyGuard, Limits, SessionLimits, event_lines_size
 from activeintent.web.live import follow
@@ -37,6 +39,7 @@ from activeintent.web.session import (
     StudyConfig,
     WebSession,
     new_session_key,
+    signal_page,
 )
 from activeintent.web.study import PID_RULE, URL_PARAMETERS, StudyFile, check_pid
 from activeintent.web.transport import ConnectionGuard, RequestPhases
@@ -44,7 +47,7 @@ from activeintent.web.transport import ConnectionGuard, RequestPhases
 STATIC = Path(__file__).parent / "static"
 MAX_FILE_NAME = 64  # longer than any video name the server writes
 log = logging.getLogger("activeintent.web")
-PAGES = {"/": "index.html", "/preference": "preference.html", "/clicker": "clicker.html", "/done": "done.html"}
+PAGES = {"/": "index.html", "/done": "done.html"}  # and each signal's own page (signal_page)
 # The session key: set when a session starts, for that session's API paths only, never readable
 # by scripts, never sent by other sites' pages; every request that writes to the session needs it.
 KEY_COOKIE = "activeintent_key"
@@ -67,9 +70,6 @@ def key_cookies(request: Request) -> list[str]:
 # Every body forbids fields it does not know and bounds every number: a typo or a probe is a
 # 422, never something silently ignored or stored. Types are strict: true is not 1, "yes" is not
 # true and 1.0 is not round 1 (pydantic would convert each); a whole number still counts as seconds.
-MAX_ROUND = 10_000
-
-
 def _client_ts():
     return Field(None, ge=0, le=1e11, allow_inf_nan=False, description="browser clock (s since the epoch)")
 
@@ -104,34 +104,12 @@ class NewSession(_Body):
         return v
 
 
-class PreferenceAnswer(_Body):
-    kind: Literal["preference"]
-    round: int = Field(ge=1, le=MAX_ROUND, description="the round this answers (as given in the session state)")
-    choice: Literal["A", "B", "cant_choose", "new_scene"]
-    client_ts: float | None = _client_ts()
-
-
-class StopAnswer(_Body):
-    kind: Literal["stop"]
-    round: int = Field(ge=1, le=MAX_ROUND, description="the round this answers (as given in the session state)")
-    action: Literal["stop", "looks_good", "new_scene"]
-    time: float | None = Field(
-        None, allow_inf_nan=False, description="for action 'stop': the video's currentTime in seconds"
-    )
-    viewing: Literal["first", "replay"] = Field(
-        "first", description="for action 'stop': during the first viewing or a replay after it")
-    client_ts: float | None = _client_ts()
-
-
 class VideoReport(_Body):
     round: int = Field(ge=1, le=MAX_ROUND, description="the round on screen")
     event: Literal["ready", "ended", "replay"] = Field(
         description="ready: the first viewing starts; ended: it played to the end; replay: a replay starts")
     media_time: float | None = Field(None, ge=0, le=1e5, allow_inf_nan=False)
     client_ts: float | None = _client_ts()
-
-
-Answer = Annotated[PreferenceAnswer | StopAnswer, Field(discriminator="kind")]
 
 
 class ClientEvent(_Body):
@@ -214,48 +192,46 @@ def answerer(session: WebSession, request: Request) -> dict:
     return session.answered_by(request.client.host if request.client else None)
 
 
-def _feedback_maker(session: WebSession, body: PreferenceAnswer | StopAnswer):
-    if body.kind != session.config.signal:
+def page_signals(config: StudyConfig, conditions: dict[str, tuple[StudyConfig, EpisodeBuilder]] | None
+                 ) -> dict[str, Signal]:
+    """The signals a study asks for (its conditions', else its own), each with a web page."""
+    names = [c.signal for c, _ in conditions.values()] if conditions else [config.signal]
+    return {n: page_signal(n) for n in names}
+
+
+def page_signal(name: str) -> Signal:
+    """The signal ``name``, if people can give it (it has a web page and form); else ValueError."""
+    signal = get_signal(name)
+    if signal.page is None or signal.WebForm is None:
+        raise ValueError(f"signal {name!r} has no web page (Signal.page and Signal.WebForm): people cannot give "
+                         f"it; signals with a page: {', '.join(n for n in SIGNALS.names() if get_signal(n).page)}")
+    for file in (signal.page, signal.how, *signal.page_assets):
+        if file is not None and not signal.page_file(file).is_file():
+            raise ValueError(f"signal {name!r}: its page file {signal.page_file(file)} does not exist")
+    return signal
+
+
+def answer_body():
+    """The answer request's body: the web form of a signal with a page, chosen by its ``kind``
+    (every such signal's, so a wrong kind is told which session asks for what)."""
+    forms = tuple(f for f in (get_signal(n).WebForm for n in SIGNALS.names()) if f is not None)
+    return forms[0] if len(forms) == 1 else Annotated[Union[forms], Field(discriminator="kind")]  # noqa: UP007
+
+
+def _from_page(session: WebSession, form: WebForm):
+    """The maker of h for the waiting question, from the page's form (by the session's signal)."""
+    if form.kind != session.config.signal:
         raise AnswerRejected(
             f"this session asks for {session.config.signal} answers (kind '{session.config.signal}'), "
-            f"not '{body.kind}'",
+            f"not '{form.kind}'",
             status=422,
         )
-
     signal = get_signal(session.config.signal)
 
     def make(q: Question) -> SignalAnswer:
-        if isinstance(body, PreferenceAnswer):
-            return signal.new_scene() if body.choice == "new_scene" else signal.parse({"choice": body.choice})
-        if body.action == "stop":
-            if body.time is None:
-                raise AnswerRejected("action 'stop' needs 'time': the video time in seconds", status=422)
-            h = stop_answer(q.trajectories[0], body.time, session.config.fps)  # outside the video: 422
-            _check_stop(session, q, body)
-            return h
-        if body.time is not None:
-            raise AnswerRejected(f"action '{body.action}' takes no 'time'", status=422)
-        if body.action == "new_scene":
-            return signal.new_scene()
-        return signal.parse({"stop_time": None})
+        return signal.from_web(form, session.shown_round(q))
 
     return make
-
-
-def _check_stop(session: WebSession, q: Question, body: StopAnswer) -> None:
-    """A stop is a moment *inside* the video: not at or after its end, and not in the first
-    viewing once the page has reported that viewing ended (a late key press)."""
-    length = q.presented[0].duration if q.presented else None
-    if length is not None and body.time is not None and body.time >= length - 1e-9:
-        raise ApiError(422, "after_video_end", f"stop time {body.time:.3f} s is at or after the end of the video "
-                       f"({length:.3f} s): the video had ended, so this is not a stop; answer looks_good or "
-                       "stop during a replay")
-    seen = session.viewing(q.round)
-    if body.viewing == "first" and seen["ended"] is not None:
-        raise ApiError(422, "after_video_end", "the first viewing of this video had ended before this stop; "
-                       "stop during a replay (viewing: 'replay') or answer looks_good")
-    if body.viewing == "replay" and not seen["replays"]:
-        raise ApiError(422, "invalid_answer", "viewing 'replay' but no replay of this round was started")
 
 
 def create_app(
@@ -273,6 +249,7 @@ def create_app(
     ``conditions`` (name → StudyConfig and builder) replace the single ``config`` for the
     sessions; ``config`` still gives the folder and the server's limits."""
     limits = limits or Limits()
+    signals = page_signals(config, conditions)
     manager = SessionManager(config, builder or runner_builder(config), conditions=conditions, study=study)
     guard = SessionLimits(manager, limits, clock=clock)
 
@@ -361,12 +338,14 @@ def create_app(
     def get_session(sid: str) -> dict:
         return session_or_404(sid).state()
 
-    @app.post("/api/sessions/{sid}/answer", summary="Answer the waiting round (names the round)")
-    def post_answer(session: Owned, request: Request, body: Answer) -> dict:
-        client = {"client_ts": body.client_ts,
-                  **({"time": body.time, "viewing": body.viewing} if isinstance(body, StopAnswer) else {})}
-        h = session.answer(body.round, _feedback_maker(session, body), client=client, by=answerer(session, request))
+    def post_answer(session: Owned, request: Request, body: WebForm) -> dict:
+        client = {name: getattr(body, name) for name in body.logged}
+        h = session.answer(body.round, _from_page(session, body), client=client, by=answerer(session, request))
         return {"accepted": True, "round": body.round, "answer": h.model_dump(mode="json")}
+
+    # the body's type is known only now (the signals registered when the app is made)
+    post_answer.__annotations__["body"] = answer_body()
+    app.post("/api/sessions/{sid}/answer", summary="Answer the waiting round (names the round)")(post_answer)
 
     @app.post("/api/sessions/{sid}/video", summary="The round's video: ready, ended or a replay starts")
     def post_video(session: Owned, body: VideoReport) -> dict:
@@ -411,7 +390,16 @@ def create_app(
         return FileResponse(path, media_type=media, headers={"Cache-Control": "no-store"})
 
     for route, page in PAGES.items():
-        app.add_api_route(route, _page(page), methods=["GET"], include_in_schema=False)
+        app.add_api_route(route, _page(STATIC / page), methods=["GET"], include_in_schema=False)
+    for name, signal in signals.items():  # each signal's own page, instructions and scripts
+        app.add_api_route(signal_page(name), _page(signal.page_file(signal.page)), methods=["GET"],
+                          include_in_schema=False)
+        if signal.how:
+            app.add_api_route(f"{signal_page(name)}/how", _page(signal.page_file(signal.how)), methods=["GET"],
+                              include_in_schema=False)
+        for asset in signal.page_assets:
+            app.add_api_route(f"{signal_page(name)}/{asset}", _file(signal.page_file(asset)), methods=["GET"],
+                              include_in_schema=False)
     app.mount("/static", StaticFiles(directory=STATIC), name="static")
     return app
 
@@ -429,11 +417,18 @@ async def _sweep(guard: SessionLimits) -> None:
             log.exception("idle sweep failed")
 
 
-def _page(name: str):
+def _page(path: Path):
     def serve_page():
-        return FileResponse(STATIC / name, media_type="text/html", headers={"Cache-Control": "no-store"})
+        return FileResponse(path, media_type="text/html", headers={"Cache-Control": "no-store"})
 
     return serve_page
+
+
+def _file(path: Path):
+    def serve_file():
+        return FileResponse(path, headers={"Cache-Control": "no-store"})
+
+    return serve_file
 
 
 def runner_builder(config: StudyConfig, **options: Any) -> EpisodeBuilder:

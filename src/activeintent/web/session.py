@@ -37,14 +37,8 @@ from pydantic import BaseModel, Field, computed_field, field_validator, model_va
 
 from activeintent.protocol import FORMAT_VERSION
 from activeintent.records import EpisodeRecorder, dumps
-from activeintent.users.human import (
-    AnswerRejected,
-    HumanUser,
-    Question,
-    SessionCancelled,
-    video_duration,
-    video_frames,
-)
+from activeintent.signals import AnswerRejected, ShownRound
+from activeintent.users.human import HumanUser, Question, SessionCancelled
 from activeintent.web.basics import VIDEO_SIZE, EstimateMode, parse_video_size, write_json
 from activeintent.web.errors import ApiError
 from activeintent.web.live import LiveExport
@@ -53,6 +47,24 @@ SESSION_ID = re.compile(r"^[0-9a-f]{16}$")
 KEY_ID_CHARS = 16  # of the key's SHA-256: enough to tell browsers apart, useless to forge one
 # Only these files are ever served from a session folder.
 SERVED_FILE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*\.(webm|gif)$")
+
+def signal_page(signal: str) -> str:
+    """The path of a signal's answer page in the web app."""
+    return f"/signal/{signal}"
+
+
+def video_frames(traj: Any, fps: int) -> int:
+    """Frames of the exported video of τ: one per 1/fps s from 0, plus the last tick when the
+    duration is not a whole number of frames (``activeintent.sim.video.frame_times``)."""
+    from activeintent.sim.video import frame_times
+
+    return len(frame_times(traj, fps))
+
+
+def video_duration(traj: Any, fps: int) -> float:
+    """Media length in seconds of the exported video: each frame is shown for 1/fps s."""
+    return video_frames(traj, fps) / fps
+
 
 Status = Literal["waiting-for-learner", "waiting-for-answer", "finished", "failed", "cancelled"]
 # (seed, out_dir, user, observers) -> Episode; the session is one of the episode's observers
@@ -511,14 +523,19 @@ class WebSession:
 
         try:
             h = self.user.answer(round, made)
-        except ApiError as err:
+        except AnswerRejected as err:
             # a stop after the video's end is kept on record, as refused (other bad answers
             # change nothing saved)
             if err.code == "after_video_end":
-                self.log_server("stop_after_end", round=round, reason=err.message, client=client, answered_by=by)
+                self.log_server("stop_after_end", round=round, reason=str(err), client=client, answered_by=by)
             raise
         self.log_server("answer", round=round, answer=h.model_dump(mode="json"), client=client, answered_by=by)
         return h
+
+    def shown_round(self, q: Question) -> ShownRound:
+        """What the person was shown in question ``q``, for the signal to read their answer."""
+        return ShownRound(trajectories=q.trajectories, video_lengths=[v.duration for v in q.presented or []],
+                          fps=self.config.fps, viewing=self.viewing(q.round))
 
     # -- what the participant did with the round's video (request threads) --------------------
     def viewing(self, round: int) -> dict:
@@ -574,6 +591,7 @@ class WebSession:
             "id": self.id,
             "method": self.config.method,
             "signal": self.config.signal,
+            "page": signal_page(self.config.signal),
             "design": self.config.design,
             "intention": self.config.intention if self.config.design == "assigned-rule" else None,
             "intention_description": self.config.intention_description,

@@ -193,17 +193,10 @@ class Assigner:
             return got
 
 
-# The answer buttons, in orders that put every answer once in every position (a Latin square);
-# a participant's order is ORDERS[slot % len(ORDERS)].
-BUTTON_ORDERS: dict[str, list[list[str]]] = {
-    "preference": [["A", "B", "cant_choose", "new_scene"], ["B", "cant_choose", "new_scene", "A"],
-                   ["cant_choose", "new_scene", "A", "B"], ["new_scene", "A", "B", "cant_choose"]],
-    "stop": [["looks_good", "new_scene"], ["new_scene", "looks_good"]],
-}
-
-
 def button_order(signal: str, slot: int, counterbalance: bool = True) -> list[str]:
-    orders = BUTTON_ORDERS.get(signal, [[]])
-    return list(orders[slot % len(orders)] if counterbalance else orders[0])
+    """The answer buttons of participant ``slot`` (the signal's counterbalanced order)."""
+    from activeintent.signals import get_signal
+
+    return get_signal(signal).button_order(slot, counterbalance)
 
 

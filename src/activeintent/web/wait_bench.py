@@ -35,7 +35,7 @@ READY = ("waiting-for-answer", "finished", "failed", "cancelled")
 def _answer(signal: str, round_: int) -> dict:
     if signal == "preference":
         return {"kind": "preference", "round": round_, "choice": "A"}
-    return {"kind": "stop", "round": round_, "action": "looks_good"}
+    return {"kind": "stop", "round": round_, "action": "no_stop"}
 
 
 def measure_waits(method: str, rounds: int, video_size: tuple[int, int], seed: int, out: Path,

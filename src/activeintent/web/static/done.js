@@ -98,7 +98,7 @@
   Study.poll((s) => {
     Study.setProgress(s);
     if (s.status === "waiting-for-answer") {
-      return Study.goTo(s.signal === "preference" ? "/preference" : "/clicker");
+      return Study.goTo(s.page);
     }
     if (s.status === "waiting-for-learner") return;
     const first = state === null;

@@ -80,7 +80,12 @@
     }
     if (s.status !== "waiting-for-learner" && s.status !== "waiting-for-answer") return Study.goTo("/done");
     $("step-how").classList.remove("hidden");
-    $(s.signal === "preference" ? "how-preference" : "how-stop").classList.remove("hidden");
+    // the signal's own instructions (a fragment from the signal's folder, as trusted as its page)
+    const how = await fetch(`${s.page}/how`, { cache: "no-store" });
+    if (how.ok) {
+      $("how").innerHTML = await how.text();
+      $("how").classList.remove("hidden");
+    }
     if (s.design === "assigned-rule") {
       $("rule-text").textContent = s.intention_description;
       $("rule-assigned").classList.remove("hidden");
@@ -98,7 +103,7 @@
     start.disabled = false;
     start.addEventListener("click", () => {
       Study.log("start_clicked");
-      Study.goTo(s.signal === "preference" ? "/preference" : "/clicker");
+      Study.goTo(s.page);
     });
   }
 })();

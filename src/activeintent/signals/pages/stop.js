@@ -1,4 +1,4 @@
-// Clicker page: one video τ. Behind a ready gate until the participant presses Ready; then it
+// The stop signal's page: one video τ. Behind a ready gate until the participant presses Ready; then it
 // plays once and Stop records the media time of the frame on screen (the server maps it to
 // the trajectory tick). When it ends, Stop is off: a late press is logged as "after end" and
 // never sent as a stop. Looks good once it has ended; Replay after the end, and a stop during a
@@ -146,17 +146,17 @@
   }
 
   stopBtn.addEventListener("click", () => send("stop", "click"));
-  goodBtn.addEventListener("click", () => send("looks_good", "click"));
+  goodBtn.addEventListener("click", () => send("no_stop", "click"));
   newBtn.addEventListener("click", () => send("new_scene", "click"));
   document.addEventListener("keydown", (e) => {
     if (Study.isTyping(e) || e.repeat || e.ctrlKey || e.metaKey || e.altKey) return;
     const k = e.key === " " ? "space" : e.key.toLowerCase();
-    const action = { space: "stop", g: "looks_good", n: "new_scene" }[k];
+    const action = { space: "stop", g: "no_stop", n: "new_scene" }[k];
     if (!action) return;
     if (round === null && e.target && e.target.tagName === "BUTTON") return; // e.g. Continue, Show colour names
     e.preventDefault(); // space must not scroll or press a focused button
     Study.log("key", { key: k, phase }, round);
-    if (action === "looks_good" && goodBtn.disabled) return;
+    if (action === "no_stop" && goodBtn.disabled) return;
     send(action, "key");
   });
 
@@ -187,9 +187,9 @@
     });
   }
 
-  Study.log("page_load", { page: "clicker" });
+  Study.log("page_load", { page: "stop" });
   Study.poll((s) => {
-    if (s.signal !== "stop") return Study.goTo("/preference");
+    if (s.page !== location.pathname) return Study.goTo(s.page);
     if (Study.routeFinished(s)) return;
     Study.setProgress(s);
     Study.setEstimate(s);

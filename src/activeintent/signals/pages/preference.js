@@ -1,4 +1,4 @@
-// Preference page: two videos τ^a, τ^b side by side; the answer is A, B, Can't choose or New scene.
+// The preference signal's page: two videos τ^a, τ^b side by side; the answer is A, B, Can't choose or New scene.
 "use strict";
 
 (() => {
@@ -92,7 +92,7 @@
 
   Study.log("page_load", { page: "preference" });
   Study.poll((s) => {
-    if (s.signal !== "preference") return Study.goTo("/clicker");
+    if (s.page !== location.pathname) return Study.goTo(s.page);
     if (Study.routeFinished(s)) return;
     Study.setProgress(s);
     Study.setEstimate(s);
