@@ -22,6 +22,7 @@ import time
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
@@ -62,6 +63,11 @@ class EpisodeConfig(BaseModel):
     max_goal_retries: int = Field(1, ge=0, description="re-asks when y cannot be turned into motion")
     video: str = Field("none", pattern="^(none|final|all)$", description="GIFs written: none, the final test, or all")
     video_fps: int = 10
+
+    @cached_property
+    def seeds(self) -> EpisodeSeeds:
+        """The one split of ``seed`` (and ``test_seed``) into the episode's named streams."""
+        return EpisodeSeeds.from_seed(self.seed, self.test_seed)
 
 
 class User(Protocol):
@@ -144,7 +150,7 @@ class Episode:
         self.out = Path(out_dir) if out_dir else None
         if self.out is not None and not any(isinstance(o, EpisodeRecorder) for o in self.observers):
             self.observers.insert(0, EpisodeRecorder(self.out))
-        self.seeds = EpisodeSeeds.from_seed(self.config.seed, self.config.test_seed)
+        self.seeds = self.config.seeds
         self.clock = _Clock()
 
     def emit(self, event: str, *args) -> None:
@@ -254,7 +260,6 @@ class Episode:
         self.emit("started", self)
         scene_rng = np.random.default_rng(self.seeds.scenes)
         layout_rng = np.random.default_rng(self.seeds.layouts)
-        learner_rng = np.random.default_rng(self.seeds.learner)
         tests = draw_test_scenes(self.seeds.test, self.config.test_scenes + self.config.test_pool)
         logs: list[RoundLog] = []
         success_at: list[float | None] = []
@@ -270,7 +275,7 @@ class Episode:
                 rate = None
             success_at.append(rate)
             while self.learner.asks and signals < cfg.budget:
-                log = self._round(len(logs), scene_rng, layout_rng, learner_rng, after_new_scene)
+                log = self._round(len(logs), scene_rng, layout_rng, after_new_scene)
                 after_new_scene = log.answer.get("new_scene", False)
                 free = after_new_scene and cfg.new_scene == "free" and free_new < FREE_NEW_SCENES
                 free_new += free
@@ -343,13 +348,13 @@ class Episode:
         self.emit("finished", result)
         return result
 
-    def _round(self, index: int, scene_rng, layout_rng, learner_rng, after_new_scene: bool) -> RoundLog:
+    def _round(self, index: int, scene_rng, layout_rng, after_new_scene: bool) -> RoundLog:
         t0 = dict(self.clock.split)
         scene, source = None, "learner"
         if after_new_scene and not self.learner.redesigns_after_new_scene:
             source = "sampled (the user asked for a new scene)"
         else:
-            scene = self.clock.timed("learner_s", self.learner.design_scene, learner_rng)
+            scene = self.clock.timed("learner_s", self.learner.design_scene)
             if scene is None:
                 source = "sampled (the learner designs no scenes, or its choice was unusable)"
             elif after_new_scene:

@@ -12,7 +12,7 @@ from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from activeintent.episode import Episode, EpisodeConfig, EpisodeSeeds
+from activeintent.episode import Episode, EpisodeConfig
 from activeintent.protocol import (
     DEFAULT_BUDGET,
     DEFAULT_TEST_POOL,
@@ -135,7 +135,10 @@ def build_episode(
     intention = resolve_intention(options.intention or (None if options.intention_file else DEFAULT_INTENTION),
                                   options.intention_file)
     models = Models(options)
-    seeds = EpisodeSeeds.from_seed(options.seed, options.test_seed)
+    config = EpisodeConfig(budget=options.budget, seed=options.seed, test_seed=options.test_seed,
+                           test_scenes=options.test_scenes, test_pool=options.test_pool, new_scene=options.new_scene, curve=options.curve,
+                           video=options.video, stop_when_done=options.stop_when_done)
+    seeds = config.seeds  # the one split of the seed: the learner's and the user's streams come from it
     llm = models.llm
     learner = method(LearnerContext(llm=llm, vlm=models.vlm, retriever=options.retriever, seed=seeds.learner,
                                     design_scenes=options.design_scenes, epsilon=options.epsilon,
@@ -146,9 +149,6 @@ def build_episode(
         user = SimulatedUser(intention, method.signal, user_profile(options.user), rng=seeds.user)
         if options.new_scene == "off":
             user.profile = user.profile.model_copy(update={"new_scene_false": 0.0, "new_scene_miss": 1.0})
-    config = EpisodeConfig(budget=options.budget, seed=options.seed, test_seed=options.test_seed,
-                           test_scenes=options.test_scenes, test_pool=options.test_pool, new_scene=options.new_scene, curve=options.curve,
-                           video=options.video, stop_when_done=options.stop_when_done)
     observers = list(observers or [])
     if getattr(intention, "goal", None) is not None:  # a goal as the hidden intention: track p(goal)
         from activeintent.bench.truth_goals import truth_tracker

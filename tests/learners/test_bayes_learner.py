@@ -44,7 +44,7 @@ def observe(learner: BayesLearner, scene: Scene, state: WorldState, answer, traj
 
 def test_estimate_gives_plans_for_the_episodes_scene():
     learner = BayesLearner("preference", rng=0)
-    scene = learner.design_scene(np.random.default_rng(0))
+    scene = learner.design_scene()
     assert scene is not None and 3 <= len(scene.objects) <= 5
     # the episode may give another layout (or another scene): plans are made for the state given
     other = Scene(objects=["green block", "yellow block", "green bowl", "purple bowl"])

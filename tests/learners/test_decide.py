@@ -40,7 +40,7 @@ def concentrated(config: LangConfig, seed: int) -> LangLearner:
 
 
 def test_scene_design_avoids_scenes_the_belief_predicts_infeasible():
-    belief = [concentrated(LangConfig(**DECIDE), seed).design_scene(None) for seed in range(8)]
+    belief = [concentrated(LangConfig(**DECIDE), seed).design_scene() for seed in range(8)]
     assert all({"red block", "blue block"} <= set(s.objects) for s in belief), [s.objects for s in belief]
     # random scenes mostly lack one of the two: the design, not luck, made them showable
     rng = np.random.default_rng(0)

@@ -372,11 +372,11 @@ def test_resuming_a_folder_made_before_variants_existed(tmp_path):
 def test_the_scene_choice_is_a_turn_of_the_conversation():
     model = ScriptedModel(respond=respond, accepts_images=False)
     learner = FaithfulMllmLlmLearner(model, config=FaithfulConfig(seed=1))
-    assert learner.design_scene(np.random.default_rng(0)) == SCENE
+    assert learner.design_scene() == SCENE
     learner.estimate(SCENE, state())
     assert [m.role for m in model.calls[-1].messages] == ["system", "user", "assistant", "user"]
     too_many = ScriptedModel([{"reasoning": "r", "blocks": ["red block", "blue block", "green block"],
                                "bowls": ["red bowl", "blue bowl", "green bowl"]}], accepts_images=False)
     learner = FaithfulMllmLlmLearner(too_many, config=FaithfulConfig(seed=1))
-    assert learner.design_scene(np.random.default_rng(0)) is None  # 6 objects: the episode samples one
+    assert learner.design_scene() is None  # 6 objects: the episode samples one
     assert "at most 5" in learner.drain_transcript()[-1]["unusable"]

@@ -40,7 +40,7 @@ def exact_answer(w_true: np.ndarray, trajectories) -> str:
 
 def ask(learner: RewardLearner, rng: np.random.Generator, index: int, answer_fn):
     sig = get_signal("preference")
-    scene = learner.design_scene(rng)
+    scene = learner.design_scene()
     state = WorldState(positions=layout(scene, int(rng.integers(2**31))))
     est = learner.estimate(scene, state)
     trajs = [symbolic_trajectory(scene, state, p) for p in est.plans]

@@ -6,7 +6,6 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass
 
-import numpy as np
 from pydantic import BaseModel, Field
 
 from activeintent.llm.base import ChatModel
@@ -72,7 +71,7 @@ class Learner(ABC):
         """Model calls and belief snapshots since the last drain, for rounds.jsonl."""
         return []
 
-    def design_scene(self, rng: np.random.Generator) -> Scene | None:
+    def design_scene(self) -> Scene | None:
         """Choose the next scene (3–5 objects), or None to let the episode sample one."""
         return None
 

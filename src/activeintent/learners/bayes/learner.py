@@ -239,7 +239,7 @@ class BayesLearner(Learner):
         keep = ranking.order(mass)[:c.n_scenes]  # most likely to be shown; ties to the first drawn
         yield from (drawn[i] for i in sorted(keep))
 
-    def design_scene(self, rng: np.random.Generator) -> Scene | None:
+    def design_scene(self) -> Scene | None:
         """The candidate scene (3–5 objects, from the learner's own rng) whose best query has
         the largest information gain (``scenes = belief``: among those the belief most expects
         to be able to show its goals)."""

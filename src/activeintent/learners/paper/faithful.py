@@ -26,7 +26,6 @@ from __future__ import annotations
 import time
 from typing import Literal
 
-import numpy as np
 from pydantic import BaseModel, ValidationError
 
 from activeintent.learners import prompts
@@ -156,7 +155,7 @@ class _FaithfulLearner(Learner):
         return {"variant": self.variant, "turns": len(self.conversation)}
 
     # -- the round ---------------------------------------------------------------------------
-    def design_scene(self, rng: np.random.Generator) -> Scene | None:
+    def design_scene(self) -> Scene | None:
         self._scoring = False
         if not self.config.design_scenes:
             return None

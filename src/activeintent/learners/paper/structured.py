@@ -14,7 +14,6 @@ import re
 import time
 from typing import Literal
 
-import numpy as np
 from pydantic import BaseModel, ValidationError
 
 from activeintent.learners import prompts
@@ -100,7 +99,7 @@ class _ModelLearner(Learner):
                           "a simpler goal similar to the previous one.")
 
     # -- scene design ------------------------------------------------------------------------
-    def design_scene(self, rng: np.random.Generator) -> Scene | None:
+    def design_scene(self) -> Scene | None:
         if not self.config.design_scenes:
             return None
         text = prompts.render("x_scene_design", task=self.task, history=self.history_text() or "nothing yet",

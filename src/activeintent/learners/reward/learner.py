@@ -159,7 +159,7 @@ class RewardLearner(Learner):
         states = [traj.initial_state] + [s.state_after for s in traj.steps]
         return np.array([self.phi(s) for s in states])
 
-    def design_scene(self, rng: np.random.Generator) -> Scene | None:
+    def design_scene(self) -> Scene | None:
         best: tuple[Scene, float] | None = None
         for _ in range(self.config.n_scenes):
             scene = random_scene(self.rng)
