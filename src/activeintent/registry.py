@@ -12,6 +12,7 @@ import importlib.util
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from types import ModuleType
 from typing import Generic, TypeVar
 
 T = TypeVar("T")
@@ -63,14 +64,15 @@ class Registry(Generic[T]):
         return name in self._factories
 
 
-def load_plugin(path: str | Path) -> None:
-    """Import a researcher's Python file once so that its ``register`` calls take effect."""
+def load_plugin(path: str | Path) -> ModuleType:
+    """Import a researcher's Python file once (its ``register`` calls take effect); the module.
+    The one loader of researchers' files: ``--plugin`` files and ``--intention-file`` files."""
     path = Path(path).resolve()
     if not path.is_file():
         raise FileNotFoundError(f"plug-in file not found: {path}")
     name = "activeintent_plugin_" + hashlib.sha256(str(path).encode()).hexdigest()[:12]
     if name in sys.modules:
-        return
+        return sys.modules[name]
     spec = importlib.util.spec_from_file_location(name, path)
     if spec is None or spec.loader is None:
         raise ValueError(f"cannot import {path} as Python")
@@ -81,3 +83,4 @@ def load_plugin(path: str | Path) -> None:
     except BaseException:
         del sys.modules[name]
         raise
+    return module

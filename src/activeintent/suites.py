@@ -15,6 +15,7 @@ import functools
 from activeintent.intentions.base import Intention
 from activeintent.intentions.registry import (
     INTENTION_NAMES,
+    INTENTIONS,
     PAPER_INTENTIONS,
     IntentionError,
     get_intention,
@@ -85,6 +86,8 @@ def suite_of(intention: str) -> str:
         return "paper"
     if intention in INTENTION_NAMES:
         return "library"
+    if intention in INTENTIONS:  # registered by a plug-in file
+        return "plugin"
     if intention.startswith("truth-") and intention in _truth_names():
         return "truth-goals"
     if intention in _heldout2_names():
@@ -94,7 +97,7 @@ def suite_of(intention: str) -> str:
 
 def resolve(name: str | None, intention_file: str | None = None) -> Intention:
     """``--intention NAME`` (any suite) or ``--intention-file path.py:NAME``."""
-    if name and not intention_file and name not in INTENTION_NAMES:
+    if name and not intention_file and name not in INTENTIONS:
         dev = _dev()
         if name in dev:
             return dev[name]

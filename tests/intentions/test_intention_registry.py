@@ -171,3 +171,21 @@ def test_grammar_only_example_intentions_load_and_are_not_named_ones():
     for name in ("PINK_BOWL", "NEXT_TO_YELLOW", "LEFT_SIDE", "WARM_LEFT_COOL_RIGHT"):
         intention = load_intention_file(f"{path}:{name}")
         assert intention.name not in INTENTION_NAMES and intention.description
+
+
+def test_a_plugin_file_registers_an_intention_that_names_resolve(tmp_path):
+    """Intentions are a registry like the other plug-in points: a --plugin file registers one,
+    and --intention NAME finds it (labelled as a plug-in's, never as a suite's)."""
+    from activeintent.registry import load_plugin
+    from activeintent.suites import resolve, suite_of
+
+    name = "never-from-a-plugin"
+    body = GOOD_BODY.format(name_line=f'name = "{name}"')
+    path = write(tmp_path, body + f'\nfrom activeintent.intentions import INTENTIONS\nINTENTIONS.register("{name}", Never)\n')
+    with pytest.raises(IntentionError, match="Unknown intention"):
+        resolve(name)
+    load_plugin(path)
+    intention = resolve(name)
+    assert intention.name == name and intention.description == "Nothing ever pleases this user."
+    assert suite_of(name) == "plugin"
+    assert name not in INTENTION_NAMES  # the library suite stays the built-in one

@@ -7,10 +7,7 @@ own); both go through :func:`resolve_intention`.
 from __future__ import annotations
 
 import difflib
-import hashlib
-import importlib.util
 import inspect
-import sys
 from pathlib import Path
 
 from activeintent.intentions.arrangements import (
@@ -29,28 +26,17 @@ from activeintent.intentions.bowls import (
     OneBowl,
 )
 from activeintent.intentions.regions import BlocksInCorners, BlocksLeftHalf, WarmLeftCoolRight
+from activeintent.registry import Registry, load_plugin
 
 PAPER_INTENTIONS: tuple[str, ...] = ("align", "stack", "color-match", "color-mismatch")
 
-_BUILTIN: dict[str, type[Intention]] = {
-    cls.name: cls
-    for cls in (
-        Align,
-        Stack,
-        ColorMatch,
-        ColorMismatch,
-        AlignVertical,
-        TwoTowers,
-        WarmInBowlsCoolStacked,
-        OneBowl,
-        OneBlockPerBowl,
-        NextToSameColorBowl,
-        BlocksInCorners,
-        BlocksLeftHalf,
-        WarmLeftCoolRight,
-    )
-}
-INTENTION_NAMES: tuple[str, ...] = tuple(_BUILTIN)
+# Intentions by name (a registry: a plug-in file adds its own with ``INTENTIONS.register``).
+INTENTIONS: Registry[Intention] = Registry("intention")
+for _cls in (Align, Stack, ColorMatch, ColorMismatch, AlignVertical, TwoTowers, WarmInBowlsCoolStacked, OneBowl,
+             OneBlockPerBowl, NextToSameColorBowl, BlocksInCorners, BlocksLeftHalf, WarmLeftCoolRight):
+    INTENTIONS.register(_cls.name, _cls, help=_cls.description)
+# the built-in ones (the library suite: fixed, whatever plug-ins add)
+INTENTION_NAMES: tuple[str, ...] = tuple(INTENTIONS.names())
 
 
 class IntentionError(ValueError):
@@ -64,19 +50,19 @@ def _normalise(name: str) -> str:
 def get_intention(name: str) -> Intention:
     """A fresh instance of the built-in intention called ``name`` (e.g. ``color-match``)."""
     key = _normalise(name)
-    if key not in _BUILTIN:
-        close = difflib.get_close_matches(key, INTENTION_NAMES, n=2)
+    if key not in INTENTIONS:
+        close = difflib.get_close_matches(key, INTENTIONS.names(), n=2)
         hint = f" Did you mean {' or '.join(repr(c) for c in close)}?" if close else ""
         raise IntentionError(
-            f"Unknown intention {name!r}.{hint} Valid intentions: {', '.join(INTENTION_NAMES)}. "
+            f"Unknown intention {name!r}.{hint} Valid intentions: {', '.join(INTENTIONS.names())}. "
             "To use your own, pass --intention-file path.py:NAME (see docs/intentions.md)."
         )
-    return _BUILTIN[key]()
+    return INTENTIONS.make(key)
 
 
 def all_intentions() -> list[Intention]:
     """One instance of every built-in intention, the paper's four first."""
-    return [cls() for cls in _BUILTIN.values()]
+    return [INTENTIONS.make(name) for name in INTENTION_NAMES]
 
 
 def is_paper_intention(intention: Intention) -> bool:
@@ -140,17 +126,9 @@ def load_intention_file(spec: str) -> Intention:
         raise IntentionError(f"--intention-file {spec!r}: expected a Python file, written path.py:NAME.")
     if not path.is_file():
         raise IntentionError(f"--intention-file {spec!r}: no such file {str(path)!r}.")
-    digest = hashlib.sha1(str(path.resolve()).encode()).hexdigest()[:12]
-    module_name = f"activeintent_user_intention_{digest}"
-    module_spec = importlib.util.spec_from_file_location(module_name, path)
-    if module_spec is None or module_spec.loader is None:
-        raise IntentionError(f"--intention-file {spec!r}: cannot load {str(path)!r} as Python.")
-    module = importlib.util.module_from_spec(module_spec)
-    sys.modules[module_name] = module  # dataclasses/pydantic in the file look their module up
     try:
-        module_spec.loader.exec_module(module)
+        module = load_plugin(path)  # the one loader of researchers' files (imported once)
     except Exception as exc:  # the user's code: report, never crash
-        sys.modules.pop(module_name, None)
         raise IntentionError(
             f"--intention-file {spec!r}: running {path.name} failed: {type(exc).__name__}: {exc}"
         ) from exc
@@ -219,6 +197,6 @@ def resolve_intention(name: str | None, intention_file: str | None) -> Intention
     if name:
         return get_intention(name)
     raise IntentionError(
-        f"No intention given: pass --intention NAME ({', '.join(INTENTION_NAMES)}) "
+        f"No intention given: pass --intention NAME ({', '.join(INTENTIONS.names())}) "
         "or --intention-file path.py:NAME."
     )
