@@ -23,7 +23,9 @@ class UnknownName(ValueError):
 
 
 class Registry(Generic[T]):
-    """Named factories of one kind (``kind`` is used in messages, e.g. "signal")."""
+    """Named entries of one kind (``kind`` is used in messages, e.g. "signal"): factories, made
+    with :meth:`make`, or objects used as they are (the goal language's node types), read with
+    ``registry[name]``. Entries keep the order they were registered in."""
 
     def __init__(self, kind: str):
         self.kind = kind
@@ -62,6 +64,19 @@ class Registry(Generic[T]):
 
     def __contains__(self, name: object) -> bool:
         return name in self._factories
+
+    def __getitem__(self, name: str) -> Callable[..., T]:
+        """The entry registered as ``name`` itself (not called); unknown names list the valid ones."""
+        return self.factory(name)
+
+    def __iter__(self):
+        return iter(self._factories)
+
+    def __len__(self) -> int:
+        return len(self._factories)
+
+    def items(self):
+        return self._factories.items()
 
 
 def load_plugin(path: str | Path) -> ModuleType:

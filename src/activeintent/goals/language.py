@@ -35,6 +35,7 @@ import numpy as np
 
 from activeintent.goals.facts import ALIGN_TOL, Facts, facts
 from activeintent.goals.planning import GRID
+from activeintent.registry import Registry
 from activeintent.world import BLOCK_SIZE, PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState
 from activeintent.world.colors import COLOR_NAMES, COOL_COLORS, WARM_COLORS
 from activeintent.world.relations import table_position_name
@@ -144,7 +145,8 @@ class Structure(Node):
         return []
 
 
-NODES: dict[str, dict[str, Node]] = {"selector": {}, "relation": {}, "structure": {}}
+# The node types by kind, each kind a registry (plug-ins add theirs with :func:`register`).
+NODES: dict[str, Registry[Node]] = {kind: Registry(kind) for kind in ("selector", "relation", "structure")}
 
 
 def register(node: Node) -> Node:
@@ -153,7 +155,7 @@ def register(node: Node) -> Node:
         raise ValueError(f"unknown node kind {node.kind!r}; valid: {', '.join(NODES)}")
     if not node.key or " " in node.key or "|" in node.key:
         raise ValueError(f"a node key is one word without '|', got {node.key!r}")
-    NODES[node.kind][node.key] = node
+    NODES[node.kind].register(node.key, node)
     return node
 
 
