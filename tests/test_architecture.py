@@ -4,6 +4,7 @@ users never see each other, nothing above world/ imports the simulator, no impor
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -163,3 +164,23 @@ def test_one_episode_loop_and_no_proxies():
     web = [name for name, path in MODULES.items() if name.startswith("activeintent.web")
            and "def __getattr__" in path.read_text()]
     assert not web, f"web proxies the episode through __getattr__: {web}"
+
+
+def test_every_plug_in_point_is_one_registry():
+    """Methods, signals, envs, user presets, intentions, executors and the goal language's node
+    types are each a registry.Registry; no module keeps a name table of its own for them."""
+    from activeintent.act.executors import EXECUTORS
+    from activeintent.envs.base import ENVS
+    from activeintent.goals.language import NODES
+    from activeintent.intentions.registry import INTENTIONS
+    from activeintent.learners.registry import METHODS
+    from activeintent.registry import Registry
+    from activeintent.signals.registry import SIGNALS
+    from activeintent.users.simulated import USER_PRESETS
+
+    points = [METHODS, SIGNALS, ENVS, USER_PRESETS, INTENTIONS, EXECUTORS, *NODES.values()]
+    assert all(isinstance(p, Registry) for p in points)
+    assert all(len(p) > 0 for p in points)
+    second = [name for name, path in MODULES.items() if name != "activeintent.registry"
+              and re.search(r"^class \w*Registry\b|^_BUILTIN\b", path.read_text(), re.M)]
+    assert not second, f"a second registry: {second}"
