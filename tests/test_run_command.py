@@ -58,7 +58,7 @@ def test_failed_model_calls_show_while_running_and_in_the_summary(tmp_path):
     text = " ".join(res.output.split())
     assert "model call failed" in text and "nothing answers at http://127.0.0.1:9/v1" in text
     assert res.exit_code == 3  # the model never answered
-    from activeintent.commands import model_summary
+    from activeintent.run_command import model_summary
 
     assert "2 failed" in model_summary("embedded", 5, ["timeout", "timeout"])
     assert model_summary("none", 0, []) == "no model (--llm none)"

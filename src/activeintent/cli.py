@@ -17,12 +17,13 @@ app = typer.Typer(
 
 # Each module defines register(app) and adds its commands.
 _COMMAND_MODULES = (
-    "activeintent.commands",
+    "activeintent.run_command",
     "activeintent.act.commands",
     "activeintent.bench.commands",
     "activeintent.bench.perf",
     "activeintent.bench.verify",
     "activeintent.intentions.commands",
+    "activeintent.learners.commands",
     "activeintent.learners.bayes.commands",
     "activeintent.llm.commands",
     "activeintent.sim.commands",
