@@ -438,7 +438,7 @@ def runner_builder(config: StudyConfig, **options: Any) -> EpisodeBuilder:
     neither shown nor scored (see :func:`activeintent.web.session.study_summary`)."""
     # People watch physics; the session exports its own videos; the learner is scored on the
     # test scenes after the last answer only (no one waits for a curve).
-    base = {"method": config.method, "budget": config.rounds, "env": "pybullet", "video": "none",
+    base = {"method": config.method, "budget": config.rounds, "env": config.env, "video": "none",
             "curve": False, **options}
     if config.intention_file is not None:
         base["intention_file"] = config.intention_file

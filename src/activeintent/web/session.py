@@ -88,6 +88,8 @@ class StudyConfig(BaseModel):
     show_estimate: EstimateMode = Field(
         "hidden", description="the learner's current guess z: never shown (hidden), shown between rounds "
         "after each answer (after-answer), or above the videos from round 2 on (always)")
+    env: str = Field("pybullet", description="the env the robot's work runs and is filmed in (people watch "
+                     "physics; it must render)")
     out_dir: Path = Path("out/web")
     seed: int = Field(0, description="session n (0, 1, …) runs with seed + n unless it asks for one")
     fps: int = Field(10, ge=1, le=60, description="frames per second of the videos")
@@ -108,6 +110,13 @@ class StudyConfig(BaseModel):
     @classmethod
     def _video_size_in_range(cls, size: tuple[int, int]) -> tuple[int, int]:
         return parse_video_size(f"{size[0]}x{size[1]}")  # the CLI's rule: 64-2048 pixels a side
+
+    @field_validator("env")
+    @classmethod
+    def _known_env(cls, v: str) -> str:
+        from activeintent.envs import ENVS
+
+        return ENVS.check(v)
 
     @model_validator(mode="after")
     def _describe_rule(self) -> StudyConfig:
