@@ -110,8 +110,12 @@ def check_options(options: RunOptions) -> None:
         raise ValueError(f"--method {options.method} needs a language model; --llm none is only for methods "
                          "that need none (bayes-*, zero-signal, random-query*).")
     from activeintent.act.executors import EXECUTORS
+    from activeintent.llm.registry import parse_spec
 
     EXECUTORS.check(options.executor)
+    for spec in (options.llm, options.vlm):
+        if spec not in (None, "none"):
+            parse_spec(spec)  # a typo in a model spec is refused before any work
 
 
 def build_episode(

@@ -8,7 +8,8 @@ from pydantic import ValidationError
 
 from activeintent.llm.accounting import CallRecord, Usage
 from activeintent.llm.base import Message
-from activeintent.llm.registry import ModelConfig, load_model, parse_spec
+from activeintent.llm.registry import load_model, parse_spec
+from activeintent.runner import Models, RunOptions, check_options
 
 
 @pytest.mark.parametrize(
@@ -34,30 +35,29 @@ def test_bad_spec_lists_valid_forms(spec):
     assert "embedded" in message and "gguf:/path/model.gguf" in message and "openai:<model-name>" in message
 
 
-def test_config_rejects_bad_options_clearly():
-    with pytest.raises(ValidationError, match="openai:<model-name>"):
-        ModelConfig(llm="gpt4")
-    with pytest.raises(ValidationError, match="record, replay, off"):
-        ModelConfig(cache_mode="replay-only")
+def test_run_options_refuse_bad_model_options_clearly():
+    with pytest.raises(ValueError, match="openai:<model-name>"):
+        check_options(RunOptions(method="preference", llm="gpt4"))
+    with pytest.raises(ValueError, match="openai:<model-name>"):
+        check_options(RunOptions(method="bayes-stop", llm="none", vlm="gpt4"))
+    with pytest.raises(ValidationError, match="record"):
+        RunOptions(cache_mode="replay-only")
 
 
-def test_config_builds_openai_models_sharing_cache_and_usage(tmp_path):
+def test_a_runs_models_share_the_cache_and_count_usage_together(tmp_path):
     with FaultServer() as server:
         server.default = Ok("fine")
-        config = ModelConfig(llm="openai:text-model", vlm="openai:vision-model",
-                             base_url=server.base_url, cache=tmp_path / "c.sqlite")
-        models = config.build()
+        models = Models(RunOptions(llm="openai:text-model", vlm="openai:vision-model",
+                                   base_url=server.base_url, cache=str(tmp_path / "c.sqlite")))
         assert models.llm is not models.vlm
         user = [Message(role="user", content="hi")]
         models.llm.chat(user)
         models.vlm.chat(user)
         models.vlm.chat(user)  # cache hit
         assert [r["model"] for r in server.requests] == ["text-model", "vision-model"]
-        totals = models.usage.snapshot()
-        assert (totals.calls, totals.cache_hits, totals.cache_misses) == (3, 1, 2)
-        models.close()
+        assert models.usage()[0] == 3  # calls, over both models
 
-        same = ModelConfig(llm="openai:m", base_url=server.base_url, cache_mode="off").build()
+        same = Models(RunOptions(llm="openai:m", vlm="openai:m", base_url=server.base_url, cache_mode="off"))
         assert same.llm is same.vlm
 
 

@@ -24,7 +24,14 @@ from concurrent.futures.process import BrokenProcessPool
 from multiprocessing import get_context
 from pathlib import Path
 
-from activeintent.bench.work import BenchOptions, WorkItem, protocol_fields, run_item
+from activeintent.bench.work import (
+    BenchOptions,
+    WorkItem,
+    bench_json,
+    protocol_fields,
+    run_item,
+    write_bench_options,
+)
 from activeintent.learners.registry import PAPER_METHODS
 from activeintent.results import (
     Rejected,
@@ -43,7 +50,7 @@ def run_bench(options: BenchOptions, out: Path, on_done: Callable[[dict, int, in
     with hold_results_folder(out):
         results_path = out / "results.jsonl"
         _check_same_settings(options, out / "bench.json")
-        (out / "bench.json").write_text(options.model_dump_json(indent=2))
+        write_bench_options(options, out / "bench.json")
         loaded = load_results(results_path)
         rejected_file = set_aside_rejected(results_path, loaded)
         if rejected_file is not None and on_rejected:
@@ -72,20 +79,13 @@ def run_bench(options: BenchOptions, out: Path, on_done: Callable[[dict, int, in
 _SETTINGS = ("seed", "run")  # methods, intentions and trials may grow on resume; these may not change
 
 
-def _legacy_run(run: dict) -> dict:
-    """Values of options that did not exist when an older folder was made: the paper's methods
-    ran what is now ``--variant structured``, ε was also eq. 3's threshold, and no test pool was scored at k = K."""
-    return {"variant": "structured", "early_threshold": run.get("epsilon", 2.0), "test_pool": 0}
-
-
 def _check_same_settings(options: BenchOptions, path: Path) -> None:
     """Resuming into a folder made with other settings would mix incomparable episodes."""
     if not path.exists():
         return
-    before = json.loads(path.read_text())
+    before = bench_json(path)  # options added since: the values they had in effect then
     now = json.loads(options.model_dump_json())
-    if isinstance(before.get("run"), dict):  # options added since: the value they had in effect then
-        before["run"] = {**_legacy_run(before["run"]), **before["run"]}
+    if isinstance(before.get("run"), dict):
         if not any(m in PAPER_METHODS for m in before.get("methods", []) + now["methods"]):
             before["run"].pop("variant", None)  # only the paper's methods have variants
             now["run"].pop("variant", None)

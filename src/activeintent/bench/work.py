@@ -3,6 +3,7 @@ function that runs one item in a worker (a pool process or a Ray task)."""
 
 from __future__ import annotations
 
+import json
 import traceback
 from pathlib import Path
 
@@ -43,6 +44,40 @@ class BenchOptions(BaseModel):
     def items(self) -> list[WorkItem]:
         names = list(self.intentions) + list(self.intention_files)
         return [WorkItem(method=m, intention=i, trial=t) for t in range(self.trials) for i in names for m in self.methods]
+
+
+# bench.json's format. 2: it says its format. 1 (no "format"): options added since take the
+# values they had in effect then (legacy_run).
+BENCH_FORMAT = 2
+
+
+def legacy_run(run: dict) -> dict:
+    """Values of options that did not exist when a format-1 folder was made: the paper's methods
+    ran what is now ``--variant structured``, ε was also eq. 3's threshold, and no test pool was
+    scored at k = K."""
+    return {"variant": "structured", "early_threshold": run.get("epsilon", 2.0), "test_pool": 0}
+
+
+def bench_json(path: Path) -> dict:
+    """A folder's bench.json as the current format's fields (a versioned reader: a format-1 file
+    gets the values its options had in effect); ValueError for a format newer than this code."""
+    data = json.loads(Path(path).read_text())
+    version = data.pop("format", 1)
+    if not isinstance(version, int) or version > BENCH_FORMAT:
+        raise ValueError(f"{path} is bench.json format {version!r}; this code reads formats 1 to {BENCH_FORMAT}: "
+                         "update activeintent")
+    if version == 1 and isinstance(data.get("run"), dict):
+        data["run"] = {**legacy_run(data["run"]), **data["run"]}
+    return data
+
+
+def read_bench_options(path: Path) -> BenchOptions:
+    """The options a results folder was made with (its bench.json, of any format)."""
+    return BenchOptions.model_validate(bench_json(path))
+
+
+def write_bench_options(options: BenchOptions, path: Path) -> None:
+    path.write_text(json.dumps({"format": BENCH_FORMAT, **json.loads(options.model_dump_json())}, indent=2))
 
 
 def protocol_fields(run: RunOptions) -> dict:

@@ -6,12 +6,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel
 
 from activeintent.llm.accounting import Usage
 from activeintent.llm.backend import BackendModel
 from activeintent.llm.base import ChatModel
-from activeintent.llm.cache import CACHE_MODES, CacheMode, ResponseCache, check_mode
+from activeintent.llm.cache import ResponseCache, check_mode
 from activeintent.llm.embedded import EmbeddedConfig
 from activeintent.llm.retry import RetryPolicy
 
@@ -90,83 +90,3 @@ def load_model(
         config = embedded or EmbeddedConfig(seed=seed)
         backend = EmbeddedBackend(parsed.target if parsed.kind == "gguf" else None, config)
     return BackendModel(backend, cache=cache, usage=usage, max_repairs=max_repairs)
-
-
-class Models(BaseModel):
-    """The paper's LLM and MLLM of one run, sharing one usage meter and one cache."""
-
-    model_config = ConfigDict(arbitrary_types_allowed=True)
-
-    llm: ChatModel
-    vlm: ChatModel
-    usage: Usage
-
-    def close(self) -> None:
-        self.llm.close()
-        if self.vlm is not self.llm:
-            self.vlm.close()
-
-
-class ModelConfig(BaseModel):
-    """What ``--llm --vlm --base-url --cache --cache-mode`` say; ``build()`` makes the models.
-
-    ``vlm`` defaults to the ``llm`` spec (then both are one model object).
-    """
-
-    llm: str = "embedded"
-    vlm: str | None = None
-    base_url: str | None = None
-    cache: Path | None = None  # None: ~/.cache/activeintent/responses.sqlite
-    cache_mode: CacheMode = "record"
-    embedded: EmbeddedConfig = Field(default_factory=EmbeddedConfig)
-    timeout_s: float = Field(default=120.0, gt=0)
-    retry: RetryPolicy = Field(default_factory=RetryPolicy)
-    max_repairs: int = Field(default=2, ge=0)
-    seed: int = 0
-
-    @field_validator("llm", "vlm")
-    @classmethod
-    def _valid_spec(cls, value: str | None) -> str | None:
-        if value is not None:
-            parse_spec(value)
-        return value
-
-    @field_validator("cache_mode", mode="before")
-    @classmethod
-    def _valid_mode(cls, value: str) -> str:
-        return check_mode(str(value))
-
-    def build(self, usage: Usage | None = None) -> Models:
-        usage = usage if usage is not None else Usage()
-        cache = ResponseCache(self.cache, self.cache_mode)
-        embedded = self.embedded.model_copy(update={"seed": self.seed})
-
-        def make(spec: str) -> ChatModel:
-            return load_model(
-                spec,
-                base_url=self.base_url,
-                cache=cache,
-                cache_mode=self.cache_mode,
-                usage=usage,
-                embedded=embedded,
-                retry=self.retry.model_copy(update={"seed": self.seed}),
-                timeout_s=self.timeout_s,
-                max_repairs=self.max_repairs,
-                seed=self.seed,
-            )
-
-        llm = make(self.llm)
-        vlm_spec = self.vlm or self.llm
-        vlm = llm if parse_spec(vlm_spec) == parse_spec(self.llm) else make(vlm_spec)
-        return Models(llm=llm, vlm=vlm, usage=usage)
-
-
-__all__ = [
-    "CACHE_MODES",
-    "ModelConfig",
-    "ModelSpec",
-    "Models",
-    "load_model",
-    "parse_spec",
-    "VALID_SPECS",
-]
