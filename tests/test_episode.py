@@ -207,9 +207,9 @@ def test_a_free_rule_final_attempt_is_on_the_first_scene_the_learners_belief_can
                                        budget=0, seed=0, test_scenes=2, test_pool=2, video="none"),
                             show_final="learner-showable")
     episode.learner.shown_mass = lambda scene: 0.9 if scene is tests[2][0] else 0.1
-    assert episode._final_shown_index(tests) == 2
+    assert episode.scoring.final_shown_index(tests) == 2
     episode.learner.shown_mass = lambda scene: 0.1
-    assert episode._final_shown_index(tests) == 0
+    assert episode.scoring.final_shown_index(tests) == 0
     episode.show_final = "first"
     episode.learner.shown_mass = lambda scene: 0.9 if scene is tests[2][0] else 0.1
-    assert episode._final_shown_index(tests) == 0
+    assert episode.scoring.final_shown_index(tests) == 0

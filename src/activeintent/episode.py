@@ -13,7 +13,8 @@ executor, the env and the user.
 Observers subscribe to events: ``started``, ``shown`` (a query's τ are ready), ``answered``
 (a round's record), ``tested`` (a test scene run in physics), ``scored`` (success after
 signal k) and ``finished``. The live table,
-the web session and the records writer are observers.
+the web session and the records writer are observers. How the test scenes are scored is
+scoring.py's (:class:`~activeintent.scoring.Scorer`); when, this loop's.
 """
 
 from __future__ import annotations
@@ -44,8 +45,9 @@ from activeintent.protocol import (
 )
 from activeintent.provenance import provenance
 from activeintent.records import EpisodeRecorder, EpisodeResult, RoundLog, TestLog
+from activeintent.scoring import Scorer
 from activeintent.signals import Answer, answer_kind_from_dump
-from activeintent.world import Scene, Skill, WorldState, apply_plan, describe_plan, layout
+from activeintent.world import Scene, Skill, WorldState, describe_plan
 from activeintent.world.trajectory import Trajectory
 
 __all__ = ["Episode", "EpisodeConfig", "EpisodeResult", "RoundLog", "TestLog", "answer_kind_from_dump"]  # records: re-exported
@@ -94,11 +96,6 @@ class EpisodeSeeds:
         if test_seed is not None:
             kids[4] = int(np.random.SeedSequence(test_seed).generate_state(1)[0])
         return cls(*kids)
-
-
-def first_feasible(intention: Intention, tests: list[tuple[Scene, int]]) -> int:
-    """Index of the first test scene that can show ``intention`` (0 when none can)."""
-    return next((i for i, (scene, _) in enumerate(tests) if intention.feasible(scene)), 0)
 
 
 @dataclass
@@ -152,6 +149,7 @@ class Episode:
             self.observers.insert(0, EpisodeRecorder(self.out))
         self.seeds = self.config.seeds
         self.clock = _Clock()
+        self.scoring = Scorer(self)
 
     def emit(self, event: str, *args) -> None:
         for obs in self.observers:
@@ -165,13 +163,13 @@ class Episode:
         failure = result.failure.feedback_text() if result.failure else None
         return list(result.plan), failure
 
-    def _executor_calls(self) -> list[dict]:
+    def executor_calls(self) -> list[dict]:
         """The executor's model calls since the last drain (y → program/plan), if it keeps them."""
         drain = getattr(self.executor, "drain_transcript", None)
         return drain() if drain is not None else []
 
-    def _ground(self, ask: Callable[[Scene, WorldState], Estimate], scene: Scene, state: WorldState
-                ) -> tuple[Estimate, list[list[Skill]], list[str | None]]:
+    def ground(self, ask: Callable[[Scene, WorldState], Estimate], scene: Scene, state: WorldState
+               ) -> tuple[Estimate, list[list[Skill]], list[str | None]]:
         """z, y from the learner and y turned into plans; y that cannot be grounded is sent back
         ("I failed to generate the goal…") up to max_goal_retries times."""
         for attempt in range(self.config.max_goal_retries + 1):
@@ -190,67 +188,13 @@ class Episode:
                 self.learner.execution_failed(goal, failure or "")
         raise AssertionError("unreachable")
 
-    def _video(self, traj: Trajectory, name: str, stop_time: float | None = None) -> None:
+    def video(self, traj: Trajectory, name: str, stop_time: float | None = None) -> None:
         if self.out is None or not self.env.renders or traj.renderer is None:
             return
         from activeintent.sim.video import export_video  # only envs that render reach here
 
         self.clock.timed("video_s", export_video, traj, self.out / f"{name}.gif", fps=self.config.video_fps,
                          stop_time=stop_time)
-
-    # -- scoring -------------------------------------------------------------------------------
-    def _score(self, k: int, tests: list[tuple[Scene, int]], final: bool) -> tuple[float | None, list[TestLog]]:
-        """The learner's current answer on the test scenes (``final``: the whole pool, else the
-        curve's); success over the feasible ones. Physics (a physics env, ``final`` only) runs on
-        the curve's scenes."""
-        physics = final and self.env.physical
-        # The final attempt shown (final.gif, the web's final video) is on a scene that can show
-        # the intention: the same scene final_z comes from (a web study may ask for the first).
-        # Asking feasibility before the learner answers is safe: the learner never sees it.
-        shown = (self._final_shown_index(tests) if self.show_final else first_feasible(self.intention, tests)) \
-            if physics else None
-        logs = []
-        for i, (scene, seed) in enumerate(tests if final else tests[:self.config.test_scenes]):
-            physics_here = physics and i < self.config.test_scenes
-            state = WorldState(positions=layout(scene, seed))
-            est, plans, failures = self._ground(self.learner.final, scene, state)
-            plan = plans[0] if plans else []
-            states, _ = self.clock.timed("scoring_s", apply_plan, state, plan)
-            end = states[-1] if states else state
-            feasible = bool(self.intention.feasible(scene))  # only now, after the learner answered
-            log = TestLog(scene=list(scene.objects), layout_seed=seed, z=est.z, goal=est.goals[0] if est.goals else "",
-                          plan=describe_plan(plan), failure=failures[0] if failures else None, feasible=feasible,
-                          success=bool(self.clock.timed("scoring_s", self.intention.satisfied, end)))
-            if physics_here:
-                self.clock.timed("env_s", self.env.reset, scene, seed)
-                traj = self.clock.timed("env_s", self.env.execute, plan)
-                log.success_physics = bool(self.clock.timed("scoring_s", self.intention.satisfied, traj.outcome))
-                log.failure = log.failure or ("; ".join(s.reason or "" for s in traj.failures) or None)
-                self.emit("tested", k, i, scene, est, traj)
-            if i == shown:
-                if not physics_here:  # beyond the curve's scenes: run it for showing only, not scored
-                    self.clock.timed("env_s", self.env.reset, scene, seed)
-                    traj = self.clock.timed("env_s", self.env.execute, plan)
-                if self.config.video != "none":
-                    self._video(traj, "final")
-                if self.show_final:
-                    self.emit("final_shown", i, scene, est, traj, feasible)
-            logs.append(log)
-        self.learner.drain_transcript()  # scoring calls are not part of any round's record
-        self._executor_calls()
-        scored = [t.success for t in logs if t.feasible]
-        rate = float(np.mean(scored)) if scored else None
-        self.emit("scored", k, rate)
-        return rate, logs
-
-    def _final_shown_index(self, tests: list[tuple[Scene, int]]) -> int:
-        if self.show_final == "first-feasible":
-            return first_feasible(self.intention, tests)
-        if self.show_final == "learner-showable":  # the learner's own P(shown), never the hidden rule
-            mass = getattr(self.learner, "shown_mass", None)
-            if mass is not None:
-                return next((i for i, (scene, _) in enumerate(tests) if mass(scene) >= 0.5), 0)
-        return 0
 
     # -- the loop ------------------------------------------------------------------------------
     def run(self) -> EpisodeResult:
@@ -270,7 +214,7 @@ class Episode:
         after_new_scene = False
         try:
             if cfg.curve or cfg.budget == 0 or not self.learner.asks:
-                rate, test_logs = self._score(0, tests, final=cfg.budget == 0)
+                rate, test_logs = self.scoring.score(0, tests, final=cfg.budget == 0)
             else:  # slow learners (model calls) are scored at k = K only
                 rate = None
             success_at.append(rate)
@@ -287,7 +231,7 @@ class Episode:
                 if log.done and done_at is None:
                     done_at = signals
                 if log.counted and (cfg.curve or signals == cfg.budget):
-                    rate, test_logs = self._score(signals, tests, final=signals == cfg.budget)
+                    rate, test_logs = self.scoring.score(signals, tests, final=signals == cfg.budget)
                     success_at.append(rate)
                 elif log.counted:
                     success_at.append(None)
@@ -297,11 +241,20 @@ class Episode:
                 # No more signals come (zero-signal baseline, or the learner finished): its answer
                 # stands for the rest of the budget, and is scored on the whole pool for k = K.
                 success_at += [rate] * (cfg.budget - len(success_at))
-                rate, test_logs = self._score(signals, tests, final=True)
+                rate, test_logs = self.scoring.score(signals, tests, final=True)
                 success_at.append(rate)
         except ModelError as err:
             error = f"model error after {signals} signals: {err}"
             success_at += [None] * (cfg.budget + 1 - len(success_at))
+        result = self._result(start, calls0, model0, logs, success_at, test_logs, signals, done_at, error)
+        self.emit("finished", result)
+        return result
+
+    def _result(self, start: float, calls0: tuple[int, int, int], model0: float, logs: list[RoundLog],
+                success_at: list[float | None], test_logs: list[TestLog], signals: int, done_at: int | None,
+                error: str | None) -> EpisodeResult:
+        """The episode's record (summary.json, a results line) from what the loop gathered."""
+        cfg = self.config
         calls1 = self.usage()
         physics_scored = [t for t in test_logs if t.feasible and t.success_physics is not None]
         split = {k: round(v, 3) for k, v in self.clock.split.items()}
@@ -345,7 +298,6 @@ class Episode:
             config={"episode": cfg.model_dump(), **self.extra_config},
             provenance=provenance(),
         )
-        self.emit("finished", result)
         return result
 
     def _round(self, index: int, scene_rng, layout_rng, after_new_scene: bool) -> RoundLog:
@@ -363,7 +315,7 @@ class Episode:
             scene = sample_round_scene(scene_rng)
         layout_seed = int(layout_rng.integers(2**31))
         state = self.clock.timed("env_s", self.env.reset, scene, layout_seed)
-        est, plans, failures = self._ground(self.learner.estimate, scene, state)
+        est, plans, failures = self.ground(self.learner.estimate, scene, state)
         labels = ["A", "B"] if len(plans) == 2 else ["y"] * len(plans)
         trajectories = []
         for i, plan in enumerate(plans):
@@ -376,7 +328,7 @@ class Episode:
         if self.config.video == "all":  # after the answer, so a stop can be marked where it came
             stop = getattr(h, "stop_time", None)
             for label, traj in zip(labels, trajectories, strict=True):
-                self._video(traj, f"round{index + 1}_{label}", stop)
+                self.video(traj, f"round{index + 1}_{label}", stop)
         record = RoundRecord(index=index, scene=scene, estimate=est, plans=plans, failures=failures, answer=h)
         r = self.clock.timed("learner_s", self.learner.observe, record, trajectories)
         return RoundLog(
@@ -385,6 +337,6 @@ class Episode:
             executed=[t.moved_anything for t in trajectories], answer=h.model_dump(mode="json"), counted=True,
             signals_used=0, retrieved=r, retriever=self.learner.retriever, done=est.done, why=est.why,
             variant=getattr(self.learner, "variant", None),
-            calls=self.learner.drain_transcript() + self._executor_calls(),
+            calls=self.learner.drain_transcript() + self.executor_calls(),
             timing={k: round(v - t0[k], 4) for k, v in self.clock.split.items()},
         )
