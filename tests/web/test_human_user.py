@@ -13,7 +13,7 @@ from activeintent.signals import AnswerRejected, ShownRound
 from activeintent.signals.preference import PreferenceAnswer
 from activeintent.signals.stop import StopAnswer, StopForm, StopSignal
 from activeintent.users.human import HumanUser, SessionCancelled
-from activeintent.web.session import video_duration, video_frames
+from activeintent.web.videos import video_duration, video_frames
 from activeintent.world import PutIn, Scene, WorldState
 from activeintent.world.trajectory import StepRecord, Trajectory
 

@@ -42,6 +42,7 @@ from activeintent.users.human import HumanUser, Question, SessionCancelled
 from activeintent.web.basics import VIDEO_SIZE, EstimateMode, parse_video_size, write_json
 from activeintent.web.errors import ApiError
 from activeintent.web.live import LiveExport
+from activeintent.web.videos import SessionVideos, VideoInfo
 
 SESSION_ID = re.compile(r"^[0-9a-f]{16}$")
 KEY_ID_CHARS = 16  # of the key's SHA-256: enough to tell browsers apart, useless to forge one
@@ -51,19 +52,6 @@ SERVED_FILE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*\.(webm|gif)$")
 def signal_page(signal: str) -> str:
     """The path of a signal's answer page in the web app."""
     return f"/signal/{signal}"
-
-
-def video_frames(traj: Any, fps: int) -> int:
-    """Frames of the exported video of τ: one per 1/fps s from 0, plus the last tick when the
-    duration is not a whole number of frames (``activeintent.sim.video.frame_times``)."""
-    from activeintent.sim.video import frame_times
-
-    return len(frame_times(traj, fps))
-
-
-def video_duration(traj: Any, fps: int) -> float:
-    """Media length in seconds of the exported video: each frame is shown for 1/fps s."""
-    return video_frames(traj, fps) / fps
 
 
 Status = Literal["waiting-for-learner", "waiting-for-answer", "finished", "failed", "cancelled"]
@@ -129,16 +117,6 @@ class StudyConfig(BaseModel):
         if self.design == "free-rule":
             self.intention_description = None
         return self
-
-
-class VideoInfo(BaseModel):
-    label: str
-    url: str
-    file: str
-    fps: int
-    frames: int
-    duration: float = Field(description="media length in seconds (frames / fps)")
-    trajectory_duration: float
 
 
 class RoundInfo(BaseModel):
@@ -320,7 +298,7 @@ class WebSession:
         self.error: str | None = None
         self.final_video: VideoInfo | None = None
         self._final_trajectory: Any = None
-        self._live: dict[str, LiveExport] = {}  # file name -> its export (the round's videos)
+        self.videos = SessionVideos(sid, self.dir, config.fps, config.video_size, config.render_workers)
         self._done = threading.Event()
         self._status_override: Status | None = None
         self._events_lock = threading.Lock()
@@ -362,9 +340,9 @@ class WebSession:
             recorder = StudyRecorder(self.dir, self.config, answered_by=self._answered_by.get)
             episode = self.builder(self.seed, self.dir, self.user, [recorder, self])
             result = episode.run()
-            self._finish_exports()
+            self.videos.finish()
             if self._final_trajectory is not None:
-                self.final_video = self._export(self._final_trajectory, "final", "final")
+                self.final_video = self.videos.export_whole(self._final_trajectory, "final", "final")
             self.result = recorder.summary or study_summary(json.loads(result.model_dump_json()), self.config)
             if result.error:
                 self.error = result.error
@@ -385,8 +363,7 @@ class WebSession:
                     episode.env.close()
                 except Exception:
                     pass
-            for export in list(self._live.values()):  # no file left half written when it ends
-                export.done.wait(60)
+            self.videos.settle()  # no file left half written when it ends
             self.ended = time.time()
             try:
                 self._write_session_file()
@@ -411,56 +388,13 @@ class WebSession:
         return not self._done.is_set()
 
     # -- the episode's hooks (worker thread) -----------------------------------------------
-    def _video_info(self, traj: Any, name: str, label: str) -> VideoInfo:
-        fps = self.config.fps
-        return VideoInfo(
-            label=label,
-            file=f"{name}.webm",
-            url=f"/api/sessions/{self.id}/files/{name}.webm",
-            fps=fps,
-            frames=video_frames(traj, fps),
-            duration=video_duration(traj, fps),
-            trajectory_duration=traj.duration,
-        )
-
-    def _export(self, traj: Any, name: str, label: str) -> VideoInfo:
-        """The whole video, written before this returns (the final attempt)."""
-        from activeintent.sim.video import export_video
-
-        export_video(traj, self.dir / f"{name}.webm", fps=self.config.fps, size=self.config.video_size,
-                     workers=self.config.render_workers)
-        return self._video_info(traj, name, label)
-
-    def _finish_exports(self) -> None:
-        """Wait until every round video is complete (a failed one fails the session)."""
-        for export in list(self._live.values()):
-            export.finish()
-
     def live_export(self, name: str) -> LiveExport | None:
         """The export still writing the file ``name``, or None (absent or complete)."""
-        export = self._live.get(name)
-        return export if export is not None and not export.done.is_set() else None
-
-    def _round_videos(self, round: int) -> list[tuple[str, str]]:
-        """(file stem, label) of a round's videos, in the order of its trajectories."""
-        if self.user.sig.shows == 2:
-            return [(f"round{round}_a", "A"), (f"round{round}_b", "B")]
-        return [(f"round{round}_y", "robot")]
+        return self.videos.live(name)
 
     def _present(self, q: Question) -> list[VideoInfo]:
-        """The round's videos, drawn at once and shown as soon as each can start playing
-        (``web.live``)."""
-        names = self._round_videos(q.round)
-        self._finish_exports()  # the previous round's videos first: two rounds never compete
-        exports = []
-        for traj, (name, _) in zip(q.trajectories, names, strict=True):
-            export = LiveExport(traj, self.dir / f"{name}.webm", self.config.fps, self.config.video_size,
-                                self.config.render_workers)
-            self._live[f"{name}.webm"] = export
-            exports.append(export)
-        for export in exports:
-            export.wait_playable()
-        videos = [self._video_info(t, n, label) for t, (n, label) in zip(q.trajectories, names, strict=True)]
+        """The round's videos, shown as soon as each can start playing (``web.live``)."""
+        videos = self.videos.round(q.round, q.trajectories)
         self.log_server(
             "round_presented",
             round=q.round,
