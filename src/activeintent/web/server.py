@@ -288,39 +288,51 @@ def create_app(
     app.state.connections = connections
     app.add_middleware(RequestPhases, guard=connections)
 
+    app.add_api_route("/api/config", lambda: config_view(config, study, manager), methods=["GET"],
+                      summary="The study's configuration (what every session runs)")
+    add_session_routes(app, manager, guard)
+    add_page_routes(app, signals)
+    app.mount("/static", StaticFiles(directory=STATIC), name="static")
+    return app
+
+
+def config_view(config: StudyConfig, study: StudyFile | None, manager: SessionManager) -> dict:
+    """GET /api/config: what every session of the study runs (a study file's conditions are not
+    for participants to read)."""
+    if study is not None:
+        # conditions differ per participant and are not for participants to read
+        return {"study": True, "consent": study.consent, "require_pid": study.require_pid,
+                "rounds": next(iter(manager.conditions.values()))[0].rounds,
+                "url_parameters": list(URL_PARAMETERS)}
+    assigned = config.design == "assigned-rule"
+    return {
+        "study": False,
+        "consent": None,
+        "require_pid": False,
+        "url_parameters": list(URL_PARAMETERS),
+        "method": config.method,
+        "signal": config.signal,
+        "rounds": config.rounds,
+        # assigned-rule: the rule participants are given (and are scored against);
+        # free-rule: every participant picks their own, nothing is scored
+        "design": config.design,
+        "intention": config.intention if assigned else None,
+        "intention_description": config.intention_description if assigned else None,
+        "show_estimate": config.show_estimate,
+        "fps": config.fps,
+        "video_size": list(config.video_size),
+    }
+
+
+def add_session_routes(app: FastAPI, manager: SessionManager, guard: SessionLimits) -> None:
+    """The session API: start, state, answer, video events, UI events, questionnaire, result, files."""
+
     def session_or_404(sid: str) -> WebSession:
         session = manager.get(sid)
         if session is None:
             raise ApiError(404, "unknown_session", f"unknown session {sid[:40]!r}")
         guard.touch(sid)  # somebody still cares about it: not idle
         return session
-
-
-    @app.get("/api/config", summary="The study's configuration (what every session runs)")
-    def get_config() -> dict:
-        if study is not None:
-            # conditions differ per participant and are not for participants to read
-            return {"study": True, "consent": study.consent, "require_pid": study.require_pid,
-                    "rounds": next(iter(manager.conditions.values()))[0].rounds,
-                    "url_parameters": list(URL_PARAMETERS)}
-        assigned = config.design == "assigned-rule"
-        return {
-            "study": False,
-            "consent": None,
-            "require_pid": False,
-            "url_parameters": list(URL_PARAMETERS),
-            "method": config.method,
-            "signal": config.signal,
-            "rounds": config.rounds,
-            # assigned-rule: the rule participants are given (and are scored against);
-            # free-rule: every participant picks their own, nothing is scored
-            "design": config.design,
-            "intention": config.intention if assigned else None,
-            "intention_description": config.intention_description if assigned else None,
-            "show_estimate": config.show_estimate,
-            "fps": config.fps,
-            "video_size": list(config.video_size),
-        }
 
     @app.post("/api/sessions", status_code=201, summary="Start a session (its episode starts at once)")
     def create_session(request: Request, response: Response, body: NewSession | None = None) -> dict:
@@ -389,6 +401,9 @@ def create_app(
             return StreamingResponse(follow(live), media_type=media, headers={"Cache-Control": "no-store"})
         return FileResponse(path, media_type=media, headers={"Cache-Control": "no-store"})
 
+
+def add_page_routes(app: FastAPI, signals: dict[str, Signal]) -> None:
+    """The start and done pages, and each signal's own page, instructions and scripts."""
     for route, page in PAGES.items():
         app.add_api_route(route, _page(STATIC / page), methods=["GET"], include_in_schema=False)
     for name, signal in signals.items():  # each signal's own page, instructions and scripts
@@ -400,8 +415,6 @@ def create_app(
         for asset in signal.page_assets:
             app.add_api_route(f"{signal_page(name)}/{asset}", _file(signal.page_file(asset)), methods=["GET"],
                               include_in_schema=False)
-    app.mount("/static", StaticFiles(directory=STATIC), name="static")
-    return app
 
 
 async def _sweep(guard: SessionLimits) -> None:
