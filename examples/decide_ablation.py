@@ -40,7 +40,7 @@ def _ablation(part: str, signal: str) -> Method:
 
     def build(ctx: LearnerContext) -> LangLearner:
         config = LangConfig(prior=ctx.prior, **{**DECIDE, **ABLATIONS[part]})
-        learner = LangLearner(signal, rng=ctx.seed, llm=ctx.llm, config=config)
+        learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=config)
         learner.name = name
         return learner
 

@@ -8,13 +8,14 @@ import sys
 
 from activeintent.act.executors import make_executor
 from activeintent.envs import make_env
-from activeintent.episode import Episode, EpisodeConfig, EpisodeSeeds
+from activeintent.episode import Episode, EpisodeConfig
 from activeintent.learners.registry import LearnerContext, get_method
 from activeintent.suites import resolve
 from activeintent.users.simulated import SimulatedUser, user_profile
 
 method = get_method(sys.argv[1] if len(sys.argv) > 1 else "bayes-stop")
-seeds = EpisodeSeeds.from_seed(7)
+config = EpisodeConfig(budget=3, seed=7)
+seeds = config.seeds  # the episode's one seed split into streams: the user's and the learner's come from it
 intention = resolve("stack")  # hidden from the learner; only the user holds it
 user = SimulatedUser(intention, method.signal, user_profile("human"), rng=seeds.user)
 llm = None
@@ -22,7 +23,7 @@ if method.needs_llm:
     from activeintent.llm.registry import load_model
 
     llm = load_model("embedded")  # or "openai:gpt-4o" with OPENAI_API_KEY set
-learner = method(LearnerContext(llm=llm, seed=seeds.learner))
+learner = method(LearnerContext(llm=llm, learner_seed=seeds.learner))
 
 
 def usage():  # the episode reports the model calls it caused
@@ -34,7 +35,7 @@ def usage():  # the episode reports the model calls it caused
 
 env = make_env("symbolic")  # or "pybullet" for physics and videos
 episode = Episode(learner, intention, user, make_executor("plan", model=llm), env,
-                  EpisodeConfig(budget=3, seed=7), out_dir="runs/example", usage=usage)
+                  config, out_dir="runs/example", usage=usage)
 result = episode.run()
 env.close()
 print(f"success@3={result.success} success_at={result.success_at} z={result.final_z!r} "

@@ -34,7 +34,7 @@ class ScriptedUser:
 
 
 def bayes_episode(method: str, user, budget: int, new_scene: str = "counted", seed: int = 4, out=None) -> Episode:
-    learner = get_method(method)(LearnerContext(seed=seed))
+    learner = get_method(method)(LearnerContext(learner_seed=seed))
     return Episode(learner, resolve("stack"), user, make_executor("parse"), SymbolicEnv(),
                    EpisodeConfig(budget=budget, seed=seed, test_scenes=10, new_scene=new_scene), out_dir=out)
 

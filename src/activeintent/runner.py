@@ -144,7 +144,7 @@ def build_episode(
                            video=options.video, stop_when_done=options.stop_when_done)
     seeds = config.seeds  # the one split of the seed: the learner's and the user's streams come from it
     llm = models.llm
-    learner = method(LearnerContext(llm=llm, vlm=models.vlm, retriever=options.retriever, seed=seeds.learner,
+    learner = method(LearnerContext(llm=llm, vlm=models.vlm, retriever=options.retriever, learner_seed=seeds.learner,
                                     design_scenes=options.design_scenes, epsilon=options.epsilon,
                                     prior=options.prior, variant=options.variant,
                                     early_threshold=options.early_threshold))

@@ -95,7 +95,7 @@ class LearnerContext:
     llm: ChatModel | None = None
     vlm: ChatModel | None = None
     retriever: str = "symbolic"
-    seed: int = 0
+    learner_seed: int = 0  # the learner's own random stream (EpisodeSeeds.learner), not the episode's seed
     design_scenes: bool = True
     epsilon: float = 2.0
     prior: str = "length"

@@ -24,7 +24,7 @@ def _bayes(signal: str, kind: str = "eig") -> Callable[[LearnerContext], Learner
         )
 
         cls = {"eig": BayesLearner, "random": RandomQueryLearner, "zero": ZeroSignalLearner}[kind]
-        return cls(signal, rng=ctx.seed, llm=ctx.llm, config=BayesConfig(prior=ctx.prior))  # type: ignore[arg-type]
+        return cls(signal, rng=ctx.learner_seed, llm=ctx.llm, config=BayesConfig(prior=ctx.prior))  # type: ignore[arg-type]
 
     return build
 
@@ -42,7 +42,7 @@ def _paper(kind: str) -> Callable[[LearnerContext], Learner]:
             from activeintent.learners.paper import faithful as f
 
             cfg = f.FaithfulConfig(design_scenes=ctx.design_scenes, epsilon=ctx.epsilon,
-                                   early_threshold=ctx.early_threshold, seed=ctx.seed)
+                                   early_threshold=ctx.early_threshold, seed=ctx.learner_seed)
             if kind == "preference":
                 return f.FaithfulPreferenceLearner(ctx.llm, cfg)  # type: ignore[arg-type]
             if kind == "mllm":
@@ -93,7 +93,7 @@ def _reward(signal: str, planner: bool = True) -> Callable[[LearnerContext], Lea
     def build(ctx: LearnerContext) -> Learner:
         from activeintent.learners.reward.learner import RewardConfig, RewardLearner
 
-        return RewardLearner(signal, rng=ctx.seed, config=RewardConfig(planner=planner))
+        return RewardLearner(signal, rng=ctx.learner_seed, config=RewardConfig(planner=planner))
 
     return build
 

@@ -225,7 +225,7 @@ def lang_method(signal: str, prefix: str = "lang"):
     settings = DECIDE if prefix == "decide" else {}
 
     def build(ctx: LearnerContext) -> LangLearner:
-        learner = LangLearner(signal, rng=ctx.seed, llm=ctx.llm,
+        learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm,
                               config=LangConfig(prior=ctx.prior, **settings))  # type: ignore[arg-type]
         learner.name = f"{prefix}-{signal}"
         return learner
