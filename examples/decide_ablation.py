@@ -39,7 +39,7 @@ def _ablation(part: str, signal: str) -> Method:
     name = f"decide-{part}-{signal}"
 
     def build(ctx: LearnerContext) -> LangLearner:
-        config = LangConfig(prior=ctx.prior, **{**DECIDE, **ABLATIONS[part]})
+        config = LangConfig(prior=ctx.config.prior, **{**DECIDE, **ABLATIONS[part]})
         learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=config)
         learner.name = name
         return learner

@@ -8,14 +8,15 @@ import sys
 
 from activeintent.act.executors import make_executor
 from activeintent.envs import make_env
-from activeintent.episode import Episode, EpisodeConfig
+from activeintent.episode import Episode
 from activeintent.learners.registry import LearnerContext, get_method
+from activeintent.spec import ProtocolConfig
 from activeintent.suites import resolve
 from activeintent.users.simulated import SimulatedUser, user_profile
 
 method = get_method(sys.argv[1] if len(sys.argv) > 1 else "bayes-stop")
-config = EpisodeConfig(budget=3, seed=7)
-seeds = config.seeds  # the episode's one seed split into streams: the user's and the learner's come from it
+protocol = ProtocolConfig(budget=3, seed=7)
+seeds = protocol.seeds  # the episode's one seed split into streams: the user's and the learner's come from it
 intention = resolve("stack")  # hidden from the learner; only the user holds it
 user = SimulatedUser(intention, method.signal, user_profile("human"), rng=seeds.user)
 llm = None
@@ -35,7 +36,7 @@ def usage():  # the episode reports the model calls it caused
 
 env = make_env("symbolic")  # or "pybullet" for physics and videos
 episode = Episode(learner, intention, user, make_executor("plan", model=llm), env,
-                  config, out_dir="runs/example", usage=usage)
+                  protocol, out_dir="runs/example", usage=usage)
 result = episode.run()
 env.close()
 print(f"success@3={result.success} success_at={result.success_at} z={result.final_z!r} "

@@ -9,13 +9,14 @@ import pytest
 
 from activeintent.act.executors import make_executor
 from activeintent.envs.symbolic import SymbolicEnv
-from activeintent.episode import Episode, EpisodeConfig
+from activeintent.episode import Episode
 from activeintent.learners.registry import LearnerContext, get_method
 from activeintent.llm.scripted import ScriptedModel
 from activeintent.protocol import FORMAT_VERSION, trial_seeds
 from activeintent.records import read_rounds
-from activeintent.runner import RunOptions, build_episode
+from activeintent.runner import RunSpec, build_episode
 from activeintent.signals import get_signal
+from activeintent.spec import LearnerConfig, ProtocolConfig
 from activeintent.suites import resolve
 from activeintent.users.simulated import SimulatedUser, user_profile
 
@@ -36,7 +37,7 @@ class ScriptedUser:
 def bayes_episode(method: str, user, budget: int, new_scene: str = "counted", seed: int = 4, out=None) -> Episode:
     learner = get_method(method)(LearnerContext(learner_seed=seed))
     return Episode(learner, resolve("stack"), user, make_executor("parse"), SymbolicEnv(),
-                   EpisodeConfig(budget=budget, seed=seed, test_scenes=10, new_scene=new_scene), out_dir=out)
+                   ProtocolConfig(budget=budget, seed=seed, test_scenes=10, new_scene=new_scene), out_dir=out)
 
 
 @pytest.mark.parametrize("method,answers", [
@@ -60,7 +61,7 @@ def test_free_rule_does_not_count_new_scene_answers_and_says_so():
 
 
 def test_budget_is_fixed_even_when_the_learner_says_done():
-    result = build_episode(RunOptions(method="bayes-stop", intention="stack", env="symbolic", llm="none",
+    result = build_episode(RunSpec.from_options(method="bayes-stop", intention="stack", env="symbolic", llm="none",
                                       user="exact", video="none", budget=6, seed=2)).run()
     assert result.signals_used == result.rounds_used == 6
 
@@ -70,7 +71,7 @@ def test_test_scenes_are_the_same_for_every_method_and_intention_of_a_trial():
     for intention in ("stack", "color-match", "one-bowl"):
         seed, test_seed = trial_seeds(7, intention, trial=1)
         for method in ("bayes-stop", "zero-signal"):
-            r = build_episode(RunOptions(method=method, intention=intention, env="symbolic", llm="none",
+            r = build_episode(RunSpec.from_options(method=method, intention=intention, env="symbolic", llm="none",
                                          video="none", budget=1, seed=seed, test_seed=test_seed)).run()
             scenes[(intention, method)] = [(t.scene, t.layout_seed) for t in r.tests]
     first = next(iter(scenes.values()))
@@ -84,7 +85,7 @@ def test_the_test_scenes_tell_a_learner_nothing_about_the_intention():
     answers = {}
     for intention in ("stack", "color-match"):
         _, test_seed = trial_seeds(0, intention, trial=0)
-        r = build_episode(RunOptions(method="zero-signal", intention=intention, env="symbolic", llm="none",
+        r = build_episode(RunSpec.from_options(method="zero-signal", intention=intention, env="symbolic", llm="none",
                                      video="none", seed=11, test_seed=test_seed)).run()
         answers[intention] = [(t.scene, t.plan, t.z) for t in r.tests]
         assert r.test_excluded == sum(not t.feasible for t in r.tests)
@@ -92,7 +93,7 @@ def test_the_test_scenes_tell_a_learner_nothing_about_the_intention():
 
 
 def test_infeasible_test_scenes_are_excluded_from_scoring_only():
-    r = build_episode(RunOptions(method="bayes-stop", intention="color-match", env="symbolic", llm="none",
+    r = build_episode(RunSpec.from_options(method="bayes-stop", intention="color-match", env="symbolic", llm="none",
                                  video="none", budget=1, seed=5)).run()
     feasible = [t for t in r.tests if t.feasible]
     assert 0 < r.test_excluded < r.test_scenes + r.test_pool == len(r.tests)
@@ -102,7 +103,7 @@ def test_infeasible_test_scenes_are_excluded_from_scoring_only():
 
 def test_same_seed_same_episode(tmp_path):
     def once(out):
-        build_episode(RunOptions(method="bayes-preference", intention="color-mismatch", env="symbolic", llm="none",
+        build_episode(RunSpec.from_options(method="bayes-preference", intention="color-mismatch", env="symbolic", llm="none",
                                  video="none", budget=3, seed=9), out).run()
         rounds = read_rounds(out / "rounds.jsonl")
         for r in rounds:
@@ -113,7 +114,7 @@ def test_same_seed_same_episode(tmp_path):
 
 
 def test_round_records_explain_the_query(tmp_path):
-    build_episode(RunOptions(method="bayes-preference", intention="stack", env="symbolic", llm="none",
+    build_episode(RunSpec.from_options(method="bayes-preference", intention="stack", env="symbolic", llm="none",
                              video="none", budget=2, seed=1), tmp_path).run()
     rounds = read_rounds(tmp_path / "rounds.jsonl")
     for r in rounds:
@@ -142,13 +143,13 @@ def scripted_answers(messages, schema):
 
 def test_an_ungroundable_goal_then_no_stop_is_a_failed_execution_not_approval(tmp_path):
     model = ScriptedModel(respond=scripted_answers, accepts_images=False)
-    learner = get_method("mllm-llm")(LearnerContext(llm=model, variant="structured"))
+    learner = get_method("mllm-llm")(LearnerContext(llm=model, config=LearnerConfig(variant="structured")))
     user = ScriptedUser("stop", [{"stop_time": None}])
     # An executor that can ground nothing: every y fails to become motion.
     executor = make_executor("parse")
     learner_goal = "make the table look nice"
     episode = Episode(learner, resolve("color-match"), user, executor, SymbolicEnv(),
-                      EpisodeConfig(budget=1, test_scenes=1, max_goal_retries=0), out_dir=tmp_path)
+                      ProtocolConfig(budget=1, test_scenes=1, max_goal_retries=0), out_dir=tmp_path)
     learner._goals = lambda *a, **k: [learner_goal]  # noqa: SLF001 - force an ungroundable y
     episode.run()
     (r,) = read_rounds(tmp_path / "rounds.jsonl")
@@ -158,7 +159,7 @@ def test_an_ungroundable_goal_then_no_stop_is_a_failed_execution_not_approval(tm
 
 def test_model_calls_are_counted_when_built_from_python():
     model = ScriptedModel(respond=scripted_answers, accepts_images=False)
-    learner = get_method("preference")(LearnerContext(llm=model, variant="structured"))
+    learner = get_method("preference")(LearnerContext(llm=model, config=LearnerConfig(variant="structured")))
     user = SimulatedUser(resolve("color-match"), "preference", user_profile("exact"), rng=0)
 
     def usage():
@@ -166,13 +167,13 @@ def test_model_calls_are_counted_when_built_from_python():
         return t.calls, t.prompt_tokens, t.completion_tokens
 
     result = Episode(learner, resolve("color-match"), user, make_executor("parse"), SymbolicEnv(),
-                     EpisodeConfig(budget=1, test_scenes=2), usage=usage).run()
+                     ProtocolConfig(budget=1, test_scenes=2), usage=usage).run()
     assert result.llm_calls == model.usage.snapshot().calls > 0
 
 
 @pytest.mark.slow
 def test_physics_scoring_at_the_end_reports_agreement(tmp_path):
-    r = build_episode(RunOptions(method="bayes-stop", intention="stack", env="pybullet", llm="none",
+    r = build_episode(RunSpec.from_options(method="bayes-stop", intention="stack", env="pybullet", llm="none",
                                  video="final", budget=1, seed=3, test_scenes=3), tmp_path).run()
     curve, pool = r.tests[:3], r.tests[3:]  # physics runs on the curve's scenes; the pool is symbolic only
     assert len(pool) == 60 and all(t.success_physics is None for t in pool)
@@ -186,7 +187,7 @@ def test_the_final_answer_reported_is_on_the_first_scene_that_can_show_the_inten
     """final_z / final_goal (what `run` prints and the final video shows) come from the first test
     scene the hidden intention can be shown on, not from scene 0 when that one cannot."""
     for seed in range(12):
-        r = build_episode(RunOptions(method="zero-signal", intention="two-towers", env="symbolic", llm="none",
+        r = build_episode(RunSpec.from_options(method="zero-signal", intention="two-towers", env="symbolic", llm="none",
                                      budget=0, seed=seed, test_scenes=4, test_pool=4, video="none")).run()
         if not r.tests[0].feasible:
             break
@@ -203,7 +204,7 @@ def test_a_free_rule_final_attempt_is_on_the_first_scene_the_learners_belief_can
     from activeintent.protocol import draw_test_scenes
 
     tests = draw_test_scenes(3, 4)
-    episode = build_episode(RunOptions(method="bayes-stop", intention="stack", env="symbolic", llm="none",
+    episode = build_episode(RunSpec.from_options(method="bayes-stop", intention="stack", env="symbolic", llm="none",
                                        budget=0, seed=0, test_scenes=2, test_pool=2, video="none"),
                             show_final="learner-showable")
     episode.learner.shown_mass = lambda scene: 0.9 if scene is tests[2][0] else 0.1

@@ -5,13 +5,13 @@ from __future__ import annotations
 
 import pytest
 
-from activeintent.episode import EpisodeSeeds
 from activeintent.protocol import (
     DEFAULT_TEST_POOL,
     DEFAULT_TEST_SCENES,
     draw_test_scenes,
     trial_seeds,
 )
+from activeintent.spec import EpisodeSeeds
 from activeintent.suites import SUITE_NAMES, resolve, suite
 
 MIN_SCORED = 5
@@ -37,10 +37,10 @@ def test_every_intention_is_scorable_on_enough_scenes_in_every_default_trial(nam
 
 
 def test_the_pool_is_the_episodes_own(tmp_path):
-    from activeintent.runner import RunOptions, build_episode
+    from activeintent.runner import RunSpec, build_episode
 
     _, test_seed = trial_seeds(0, "any intention", 3)
-    r = build_episode(RunOptions(method="zero-signal", intention="two-towers", env="symbolic", llm="none",
+    r = build_episode(RunSpec.from_options(method="zero-signal", intention="two-towers", env="symbolic", llm="none",
                                  video="none", budget=1, seed=1, test_seed=test_seed)).run()
     assert [t.scene for t in r.tests] == [list(s.objects) for s in pool(3)]
     assert r.test_scored == sum(bool(resolve("two-towers").feasible(s)) for s in pool(3)) >= MIN_SCORED

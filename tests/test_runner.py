@@ -9,7 +9,7 @@ from activeintent.goals.language import Each, Goal
 from activeintent.learners.lang import learner as lang_learner
 from activeintent.learners.lang.hypotheses import LangSpace
 from activeintent.learners.registry import METHODS, PAPER_METHODS
-from activeintent.runner import RunOptions, build_episode
+from activeintent.runner import RunSpec, build_episode
 from activeintent.signals import get_signal
 
 
@@ -54,7 +54,7 @@ def test_every_learner_assumes_the_signals_learner_model_never_the_users(user, s
         if method.needs_llm:  # cannot be built with --llm none; they have no observation model
             assert name in PAPER_METHODS, f"{name} needs a model: check its assumptions here too"
             continue
-        episode = build_episode(RunOptions(method=name, intention="stack", env="symbolic", llm="none",
+        episode = build_episode(RunSpec.from_options(method=name, intention="stack", env="symbolic", llm="none",
                                            user=user, video="none", budget=1))
         learner, simulated = episode.learner, episode.user
         sig = get_signal(method.signal)

@@ -23,23 +23,17 @@ import time
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import cached_property
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
 import numpy as np
-from pydantic import BaseModel, Field
 
 from activeintent.envs import Env
 from activeintent.intentions.base import Intention
 from activeintent.learners.base import Estimate, Learner, RoundRecord
 from activeintent.llm.base import ModelError
 from activeintent.protocol import (
-    DEFAULT_BUDGET,
-    DEFAULT_TEST_POOL,
-    DEFAULT_TEST_SCENES,
     FREE_NEW_SCENES,
-    NewSceneRule,
     draw_test_scenes,
     sample_round_scene,
 )
@@ -47,29 +41,11 @@ from activeintent.provenance import provenance
 from activeintent.records import EpisodeRecorder, EpisodeResult, RoundLog, TestLog
 from activeintent.scoring import Scorer
 from activeintent.signals import Answer, answer_kind_from_dump
+from activeintent.spec import ProtocolConfig
 from activeintent.world import Scene, Skill, WorldState, describe_plan
 from activeintent.world.trajectory import Trajectory
 
-__all__ = ["Episode", "EpisodeConfig", "EpisodeResult", "RoundLog", "TestLog", "answer_kind_from_dump"]  # records: re-exported
-
-
-class EpisodeConfig(BaseModel):
-    budget: int = Field(DEFAULT_BUDGET, ge=0, le=100, description="K: signals the user gives")
-    seed: int = Field(0, ge=0, description="seed of the episode's query scenes, user noise and learner")
-    test_seed: int | None = Field(None, ge=0, description="seed of the test scenes (default: from seed)")
-    test_scenes: int = Field(DEFAULT_TEST_SCENES, ge=1, le=200, description="test scenes scored after every signal")
-    test_pool: int = Field(DEFAULT_TEST_POOL, ge=0, le=1000, description="more test scenes, scored at k = K only")
-    new_scene: NewSceneRule = "counted"
-    stop_when_done: bool = Field(False, description="end early when a learner allowed to finish says done (not in benchmarks)")
-    curve: bool = Field(True, description="score after every signal (False: only at k = K)")
-    max_goal_retries: int = Field(1, ge=0, description="re-asks when y cannot be turned into motion")
-    video: str = Field("none", pattern="^(none|final|all)$", description="GIFs written: none, the final test, or all")
-    video_fps: int = 10
-
-    @cached_property
-    def seeds(self) -> EpisodeSeeds:
-        """The one split of ``seed`` (and ``test_seed``) into the episode's named streams."""
-        return EpisodeSeeds.from_seed(self.seed, self.test_seed)
+__all__ = ["Episode", "EpisodeResult", "RoundLog", "TestLog", "answer_kind_from_dump"]  # records: re-exported
 
 
 class User(Protocol):
@@ -78,24 +54,6 @@ class User(Protocol):
 
 class PlanExecutor(Protocol):
     def to_plan(self, instruction: str, state: WorldState) -> Any: ...
-
-
-@dataclass
-class EpisodeSeeds:
-    """Every random choice flows from one seed; the test scenes from the trial's test seed."""
-
-    scenes: int
-    layouts: int
-    user: int
-    learner: int
-    test: int
-
-    @classmethod
-    def from_seed(cls, seed: int, test_seed: int | None = None) -> EpisodeSeeds:
-        kids = [int(k.generate_state(1)[0]) for k in np.random.SeedSequence(seed).spawn(5)]
-        if test_seed is not None:
-            kids[4] = int(np.random.SeedSequence(test_seed).generate_state(1)[0])
-        return cls(*kids)
 
 
 @dataclass
@@ -122,7 +80,7 @@ class Episode:
         user: User,
         executor: PlanExecutor,
         env: Env,
-        config: EpisodeConfig | None = None,
+        protocol: ProtocolConfig | None = None,
         observers: list[Any] | None = None,
         usage: Callable[[], tuple[int, int, int]] | None = None,
         model_time: Callable[[], float] | None = None,
@@ -139,7 +97,7 @@ class Episode:
         # the records: None (the default) changes nothing.
         self.show_final = show_final
         self.executor, self.env = executor, env
-        self.config = config or EpisodeConfig()
+        self.protocol = protocol or ProtocolConfig()
         self.observers = list(observers or [])
         self.usage = usage or (lambda: (0, 0, 0))
         self.model_time = model_time or (lambda: 0.0)
@@ -147,7 +105,7 @@ class Episode:
         self.out = Path(out_dir) if out_dir else None
         if self.out is not None and not any(isinstance(o, EpisodeRecorder) for o in self.observers):
             self.observers.insert(0, EpisodeRecorder(self.out))
-        self.seeds = self.config.seeds
+        self.seeds = self.protocol.seeds
         self.clock = _Clock()
         self.scoring = Scorer(self)
 
@@ -172,7 +130,7 @@ class Episode:
                ) -> tuple[Estimate, list[list[Skill]], list[str | None]]:
         """z, y from the learner and y turned into plans; y that cannot be grounded is sent back
         ("I failed to generate the goal…") up to max_goal_retries times."""
-        for attempt in range(self.config.max_goal_retries + 1):
+        for attempt in range(self.protocol.max_goal_retries + 1):
             est = self.clock.timed("learner_s", ask, scene, state)
             if est.plans is not None:
                 return est, [list(p) for p in est.plans], [None] * len(est.plans)
@@ -182,7 +140,7 @@ class Episode:
                 plans.append(plan)
                 failures.append(failure)
             bad = [(g, f) for g, f in zip(est.goals, failures, strict=False) if f]
-            if not bad or attempt == self.config.max_goal_retries:
+            if not bad or attempt == self.protocol.max_goal_retries:
                 return est, plans, failures
             for goal, failure in bad:
                 self.learner.execution_failed(goal, failure or "")
@@ -193,18 +151,18 @@ class Episode:
             return
         from activeintent.sim.video import export_video  # only envs that render reach here
 
-        self.clock.timed("video_s", export_video, traj, self.out / f"{name}.gif", fps=self.config.video_fps,
+        self.clock.timed("video_s", export_video, traj, self.out / f"{name}.gif", fps=self.protocol.video_fps,
                          stop_time=stop_time)
 
     # -- the loop ------------------------------------------------------------------------------
     def run(self) -> EpisodeResult:
         start = time.perf_counter()
         calls0, model0 = self.usage(), self.model_time()
-        cfg = self.config
+        cfg = self.protocol
         self.emit("started", self)
         scene_rng = np.random.default_rng(self.seeds.scenes)
         layout_rng = np.random.default_rng(self.seeds.layouts)
-        tests = draw_test_scenes(self.seeds.test, self.config.test_scenes + self.config.test_pool)
+        tests = draw_test_scenes(self.seeds.test, self.protocol.test_scenes + self.protocol.test_pool)
         logs: list[RoundLog] = []
         success_at: list[float | None] = []
         test_logs: list[TestLog] = []
@@ -254,7 +212,7 @@ class Episode:
                 success_at: list[float | None], test_logs: list[TestLog], signals: int, done_at: int | None,
                 error: str | None) -> EpisodeResult:
         """The episode's record (summary.json, a results line) from what the loop gathered."""
-        cfg = self.config
+        cfg = self.protocol
         calls1 = self.usage()
         physics_scored = [t for t in test_logs if t.feasible and t.success_physics is not None]
         split = {k: round(v, 3) for k, v in self.clock.split.items()}
@@ -325,7 +283,7 @@ class Episode:
             failures[i] = failures[i] or ("; ".join(s.reason or "" for s in traj.failures) or None)
         self.emit("shown", index, scene, est, trajectories)
         h = self.clock.timed("user_s", self.user.respond, scene, trajectories)
-        if self.config.video == "all":  # after the answer, so a stop can be marked where it came
+        if self.protocol.video == "all":  # after the answer, so a stop can be marked where it came
             stop = getattr(h, "stop_time", None)
             for label, traj in zip(labels, trajectories, strict=True):
                 self.video(traj, f"round{index + 1}_{label}", stop)

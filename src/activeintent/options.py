@@ -1,16 +1,18 @@
 """Command-line options shared by `run`, `bench` and `serve`: declared once here, defaults
-read from :class:`activeintent.runner.RunOptions` (``D``), so nothing is typed twice."""
+read from :class:`activeintent.spec.RunSpec` (``D``: its defaults under the options' names), so
+nothing is typed twice."""
 
 from __future__ import annotations
 
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Annotated
 
 import typer
 
-from activeintent.runner import RunOptions
+from activeintent.spec import RunSpec
 
-D = RunOptions()  # the defaults
+D = SimpleNamespace(**RunSpec().options())  # the defaults, by option name
 
 Method = Annotated[str, typer.Option("--method", help="Learner (see `activeintent methods`)")]
 Intention = Annotated[str | None, typer.Option("--intention", help="Hidden intention (see `activeintent intentions`)")]
@@ -47,20 +49,12 @@ def check_only() -> bool:
     return os.environ.get("ACTIVEINTENT_CHECK_ONLY") == "1"
 
 
-def run_options(**values) -> RunOptions:
-    """RunOptions from CLI values; a bad value becomes a message naming the option."""
-    from pydantic import ValidationError
-
+def run_spec(**values) -> RunSpec:
+    """The run's spec from CLI values (None: the default); a bad value becomes a message naming
+    the option."""
     values = {k: v for k, v in values.items() if v is not None or k in ("intention", "intention_file", "vlm")}
     values["plugins"] = list(values.get("plugins") or [])
-    try:
-        return RunOptions(**values)
-    except ValidationError as err:
-        msgs = []
-        for e in err.errors():
-            name = "--" + str(e["loc"][0]).replace("_", "-")
-            msgs.append(f"{name}: {e['msg']} (got {e.get('input')!r})")
-        raise ValueError("; ".join(msgs)) from None
+    return RunSpec.from_options(**values)
 
 
 def _video_size(text: str) -> tuple[int, int]:

@@ -147,7 +147,7 @@ def run(
 
         allow_unsafe_no_isolation()
     try:
-        options = opt.run_options(
+        spec = opt.run_spec(
             method=method, intention=intention, intention_file=intention_file, plugins=plugin, budget=budget,
             seed=seed, test_scenes=test_scenes, test_pool=test_pool, env=env, user=user, new_scene=new_scene, prior=prior, llm=llm,
             vlm=vlm, base_url=base_url, cache=cache, cache_mode=cache_mode, executor=executor,
@@ -162,10 +162,10 @@ def run(
     live = LiveTable(console, method, budget, seed, llm=llm, lines=not console.is_terminal)
     if opt.check_only():
         try:
-            from activeintent.runner import check_options
+            from activeintent.runner import check_spec
             from activeintent.suites import resolve
 
-            check_options(options)
+            check_spec(spec)
             resolve(intention or (None if intention_file else DEFAULT_INTENTION), intention_file)
         except (ValueError, FileNotFoundError) as err:
             console.print(f"[red]error:[/red] {err}")
@@ -175,7 +175,7 @@ def run(
         if live.lines:  # a log sees a live display only at the end: plain lines instead
             print_line(console, f"loading models and simulator… ({'no model' if llm == 'none' else 'model ' + llm})")
         with console.status("loading models and simulator…"):
-            episode = build_episode(options, out_dir, observers=[live])
+            episode = build_episode(spec, out_dir, observers=[live])
         shown = nullcontext() if live.lines else Live(Group(live.table, live.progress), console=console,
                                                       refresh_per_second=4)
         with shown:

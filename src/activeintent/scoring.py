@@ -44,8 +44,8 @@ class Scorer:
         else:
             shown = self.final_shown_index(tests) if ep.show_final else first_feasible(ep.intention, tests)
         logs = []
-        for i, (scene, seed) in enumerate(tests if final else tests[:ep.config.test_scenes]):
-            physics_here = physics and i < ep.config.test_scenes
+        for i, (scene, seed) in enumerate(tests if final else tests[:ep.protocol.test_scenes]):
+            physics_here = physics and i < ep.protocol.test_scenes
             state = WorldState(positions=layout(scene, seed))
             est, plans, failures = ep.ground(ep.learner.final, scene, state)
             plan = plans[0] if plans else []
@@ -65,7 +65,7 @@ class Scorer:
                 if not physics_here:  # beyond the curve's scenes: run it for showing only, not scored
                     ep.clock.timed("env_s", ep.env.reset, scene, seed)
                     traj = ep.clock.timed("env_s", ep.env.execute, plan)
-                if ep.config.video != "none":
+                if ep.protocol.video != "none":
                     ep.video(traj, "final")
                 if ep.show_final:
                     ep.emit("final_shown", i, scene, est, traj, feasible)

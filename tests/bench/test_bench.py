@@ -16,10 +16,10 @@ import pytest
 
 from activeintent.bench.report import wilson, write_report
 from activeintent.bench.runner import run_bench
-from activeintent.bench.work import BenchOptions
+from activeintent.bench.work import BenchConfig
 from activeintent.protocol import FORMAT_VERSION, trial_seeds
 from activeintent.results import read_results
-from activeintent.runner import RunOptions
+from activeintent.runner import RunSpec
 
 ROOT = Path(__file__).resolve().parents[2]
 METHODS = ["bayes-stop", "zero-signal"]
@@ -27,9 +27,9 @@ INTENTIONS = ["stack", "color-match"]
 PROTOCOL = ("env", "user_preset", "budget", "new_scene", "prior", "test_scenes")
 
 
-def tiny(jobs: int = 1, **run) -> BenchOptions:
-    return BenchOptions(methods=METHODS, intentions=INTENTIONS, trials=1, seed=5, jobs=jobs,
-                        run=RunOptions(budget=2, llm="none", env="symbolic", video="none", **run))
+def tiny(jobs: int = 1, **run) -> BenchConfig:
+    return BenchConfig(methods=METHODS, intentions=INTENTIONS, trials=1, seed=5, jobs=jobs,
+                        run=RunSpec.from_options(budget=2, llm="none", env="symbolic", video="none", **run))
 
 
 def test_wilson_interval_matches_known_values():
@@ -112,7 +112,7 @@ def test_tiny_bench_records_the_protocol_and_reports_intervals_and_baselines(tmp
 
 def test_resume_skips_finished_and_drops_a_torn_line(tmp_path):
     out = tmp_path / "b"
-    first = run_bench(BenchOptions(**{**tiny().model_dump(), "methods": METHODS[1:]}), out)
+    first = run_bench(BenchConfig(**{**tiny().model_dump(), "methods": METHODS[1:]}), out)
     assert len(first) == 2
     with (out / "results.jsonl").open("a") as f:
         f.write('{"method": "bayes-stop", "intent')  # a write cut off by a kill
@@ -123,15 +123,15 @@ def test_resume_skips_finished_and_drops_a_torn_line(tmp_path):
 
 
 def test_resume_refuses_other_settings(tmp_path):
-    run_bench(BenchOptions(**{**tiny().model_dump(), "trials": 1, "methods": ["zero-signal"]}), tmp_path)
+    run_bench(BenchConfig(**{**tiny().model_dump(), "trials": 1, "methods": ["zero-signal"]}), tmp_path)
     with pytest.raises(ValueError, match="other settings"):
         run_bench(tiny(user="exact"), tmp_path)
 
 
 def test_a_plugin_signal_runs_in_bench_without_package_changes(tmp_path):
     plugin = str(ROOT / "examples" / "my_signal.py")
-    options = BenchOptions(methods=["bayes-rating"], intentions=["stack"], trials=1, seed=1,
-                           run=RunOptions(budget=3, llm="none", env="symbolic", video="none", plugins=[plugin]))
+    options = BenchConfig(methods=["bayes-rating"], intentions=["stack"], trials=1, seed=1,
+                           run=RunSpec.from_options(budget=3, llm="none", env="symbolic", video="none", plugins=[plugin]))
     (r,) = run_bench(options, tmp_path)
     assert r.get("error") is None and r["method"] == "bayes-rating"
     assert r["signals_used"] == 3 and set(r["answers"]) <= {"rating", "new_scene"}
@@ -204,8 +204,8 @@ class Crash(type(_stack)):
 def test_a_dying_worker_is_recorded_and_the_bench_goes_on(tmp_path):
     path = tmp_path / "crash.py"
     path.write_text(CRASHING_INTENTION)
-    options = BenchOptions(methods=["zero-signal"], intentions=["stack"], intention_files=[f"{path}:Crash"],
-                           trials=1, seed=5, jobs=2, run=RunOptions(budget=1, llm="none", env="symbolic", video="none"))
+    options = BenchConfig(methods=["zero-signal"], intentions=["stack"], intention_files=[f"{path}:Crash"],
+                           trials=1, seed=5, jobs=2, run=RunSpec.from_options(budget=1, llm="none", env="symbolic", video="none"))
     records = run_bench(options, tmp_path / "out")
     by = {r["intention"]: r for r in records}
     assert len(records) == 2

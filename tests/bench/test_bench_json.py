@@ -10,39 +10,47 @@ import pytest
 
 from activeintent.bench.work import (
     BENCH_FORMAT,
-    BenchOptions,
-    read_bench_options,
-    write_bench_options,
+    BenchConfig,
+    read_bench_config,
+    write_bench_config,
 )
-from activeintent.runner import RunOptions
+from activeintent.runner import RunSpec
 
 RESULTS = Path(__file__).resolve().parents[2] / "docs" / "results"
 
 
 def test_written_with_its_format_and_read_back(tmp_path):
-    options = BenchOptions(methods=["bayes-stop"], intentions=["stack"], trials=3, run=RunOptions(video="none"))
-    write_bench_options(options, tmp_path / "bench.json")
+    options = BenchConfig(methods=["bayes-stop"], intentions=["stack"], trials=3, run=RunSpec.from_options(video="none"))
+    write_bench_config(options, tmp_path / "bench.json")
     assert json.loads((tmp_path / "bench.json").read_text())["format"] == BENCH_FORMAT
-    assert read_bench_options(tmp_path / "bench.json") == options
+    assert read_bench_config(tmp_path / "bench.json") == options
 
 
 def test_a_format_1_file_gets_the_options_in_effect_then(tmp_path):
-    data = json.loads(BenchOptions(methods=["mllm"], run=RunOptions(video="none", epsilon=1.5)).model_dump_json())
+    data = json.loads(BenchConfig(methods=["mllm"]).model_dump_json())
+    data["run"] = RunSpec.from_options(video="none", epsilon=1.5).options()  # flat, as format 1 wrote it
     for key in ("variant", "early_threshold", "test_pool"):
         data["run"].pop(key)
     (tmp_path / "bench.json").write_text(json.dumps(data))  # no "format": format 1
-    run = read_bench_options(tmp_path / "bench.json").run
-    assert (run.variant, run.early_threshold, run.test_pool) == ("structured", 1.5, 0)
+    run = read_bench_config(tmp_path / "bench.json").run
+    assert (run.learner.variant, run.learner.early_threshold, run.protocol.test_pool) == ("structured", 1.5, 0)
+
+
+def test_a_format_2_file_in_flat_option_names_reads_as_the_same_spec(tmp_path):
+    spec = RunSpec.from_options(video="none", budget=7, env="symbolic", llm="none", user="paper", prior="uniform")
+    data = {**json.loads(BenchConfig(methods=["bayes-stop"]).model_dump_json()), "format": 2, "run": spec.options()}
+    (tmp_path / "bench.json").write_text(json.dumps(data))
+    assert read_bench_config(tmp_path / "bench.json").run == spec
 
 
 def test_a_newer_format_is_refused(tmp_path):
     (tmp_path / "bench.json").write_text(json.dumps({"format": BENCH_FORMAT + 1, "methods": ["bayes-stop"]}))
     with pytest.raises(ValueError, match="update activeintent"):
-        read_bench_options(tmp_path / "bench.json")
+        read_bench_config(tmp_path / "bench.json")
 
 
 def test_every_committed_folder_reads():
     folders = sorted(p for p in RESULTS.glob("*/bench.json"))
     assert len(folders) >= 10
     for path in folders:
-        assert read_bench_options(path).methods, path
+        assert read_bench_config(path).methods, path

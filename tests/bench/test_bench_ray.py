@@ -14,9 +14,9 @@ from pathlib import Path
 import pytest
 
 from activeintent.bench.runner import run_bench
-from activeintent.bench.work import BenchOptions
+from activeintent.bench.work import BenchConfig
 from activeintent.results import read_results
-from activeintent.runner import RunOptions
+from activeintent.runner import RunSpec
 
 ray = pytest.importorskip("ray")
 
@@ -25,9 +25,9 @@ INTENTIONS = ["stack", "color-match"]
 COMPARED = ("method", "intention", "trial", "seed", "success_at", "signals_used", "answers", "final_goal")
 
 
-def tiny(backend: str = "local", **changes) -> BenchOptions:
-    options = BenchOptions(methods=METHODS, intentions=INTENTIONS, trials=1, seed=5, jobs=2, backend=backend,
-                           run=RunOptions(budget=2, test_pool=10, llm="none", env="symbolic", video="none"))
+def tiny(backend: str = "local", **changes) -> BenchConfig:
+    options = BenchConfig(methods=METHODS, intentions=INTENTIONS, trials=1, seed=5, jobs=2, backend=backend,
+                           run=RunSpec.from_options(budget=2, test_pool=10, llm="none", env="symbolic", video="none"))
     return options.model_copy(update=changes)
 
 

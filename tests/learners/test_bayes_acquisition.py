@@ -90,10 +90,10 @@ class GainCheck:
 def test_the_round_log_gives_the_eig_of_the_query_shown(method):
     """Through the episode loop: each round's ``why["eig_nats"]`` is the EIG of the
     trajectories that round showed, under the belief the learner held when it chose them."""
-    from activeintent.runner import RunOptions, build_episode
+    from activeintent.runner import RunSpec, build_episode
 
     check = GainCheck()
-    options = RunOptions(method=method, intention="color-match", env="symbolic", llm="none", budget=3,
+    options = RunSpec.from_options(method=method, intention="color-match", env="symbolic", llm="none", budget=3,
                          video="none", seed=1, curve=False, user="exact")
     result = build_episode(options, observers=[check]).run()
     assert result.error is None, result.error

@@ -19,7 +19,7 @@ from activeintent.learners.bayes.learner import (
     RandomQueryLearner,
     ZeroSignalLearner,
 )
-from activeintent.runner import RunOptions, build_episode
+from activeintent.runner import RunSpec, build_episode
 from activeintent.signals.preference import PreferenceAnswer
 from activeintent.signals.stop import StopAnswer
 from activeintent.users.simulated import SimulatedUser, user_profile
@@ -232,7 +232,7 @@ def test_done_when_one_hypothesis_holds_the_threshold():
 @cache
 def episode(method: str, intention: str, user: str, seed: int):
     # curve=False: success is scored at k = 0 and k = K only (the same success@K, less time)
-    options = RunOptions(method=method, intention=intention, env="symbolic", llm="none", user=user,
+    options = RunSpec.from_options(method=method, intention=intention, env="symbolic", llm="none", user=user,
                          video="none", seed=seed, curve=False)
     result = build_episode(options).run()
     assert result.error is None, result.error

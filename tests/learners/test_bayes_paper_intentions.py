@@ -12,7 +12,7 @@ from functools import cache
 
 import pytest
 
-from activeintent.runner import RunOptions, build_episode
+from activeintent.runner import RunSpec, build_episode
 
 # the hypothesis of the grammar that agrees with each intention
 EXPECTED_TOP = {"align": "all:row", "stack": "all:tower", "color-match": "all:in-same-bowl",
@@ -22,7 +22,7 @@ SEED = 11
 
 @cache
 def episode(method: str, intention: str):
-    options = RunOptions(method=method, intention=intention, env="symbolic", llm="none", user="exact",
+    options = RunSpec.from_options(method=method, intention=intention, env="symbolic", llm="none", user="exact",
                          video="none", seed=SEED, curve=False)
     result = build_episode(options).run()
     assert result.error is None, result.error

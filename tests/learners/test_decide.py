@@ -8,7 +8,7 @@ import pytest
 
 from activeintent.act.executors import make_executor
 from activeintent.envs.symbolic import SymbolicEnv
-from activeintent.episode import Episode, EpisodeConfig
+from activeintent.episode import Episode
 from activeintent.goals.language import parse_goal
 from activeintent.learners.bayes.acquisition import select_query
 from activeintent.learners.bayes.candidates import Outcome
@@ -22,6 +22,7 @@ from activeintent.learners.lang.learner import DECIDE, LangConfig, LangLearner
 from activeintent.learners.registry import LearnerContext, get_method
 from activeintent.signals import get_signal
 from activeintent.signals.base import Signal
+from activeintent.spec import ProtocolConfig
 from activeintent.suites import resolve
 from activeintent.users.simulated import SimulatedUser, user_profile
 
@@ -164,7 +165,7 @@ def _rounds(config: LangConfig, seed: int = 3) -> list[tuple]:
             seen.append((tuple(log.scene), tuple(log.plans), log.scene_source))
 
     Episode(learner, intention, user, make_executor("plan"), SymbolicEnv(),
-            EpisodeConfig(budget=3, seed=seed, test_scenes=1, test_pool=0, curve=False), observers=[Watch()]).run()
+            ProtocolConfig(budget=3, seed=seed, test_scenes=1, test_pool=0, curve=False), observers=[Watch()]).run()
     return seen
 
 
@@ -179,7 +180,7 @@ def test_decide_records_what_each_answer_taught():
     intention = resolve("dev-warm-on-cool")
     result = Episode(learner, intention, SimulatedUser(intention, "stop", user_profile("exact"), rng=0),
                      make_executor("plan"), SymbolicEnv(),
-                     EpisodeConfig(budget=2, seed=0, test_scenes=1, test_pool=0, curve=False)).run()
+                     ProtocolConfig(budget=2, seed=0, test_scenes=1, test_pool=0, curve=False)).run()
     rows = result.diagnostics["answers"]
     assert len(rows) == 2 and {"answer", "kl_bits", "gain_bits", "shown_mass", "top"} <= set(rows[0])
     assert all(r["kl_bits"] >= 0 for r in rows) and rows[0]["answer"] in result.answers
@@ -187,9 +188,9 @@ def test_decide_records_what_each_answer_taught():
 
 
 def test_the_bench_reads_the_belief_on_a_hidden_goal_without_telling_the_learner():
-    from activeintent.runner import RunOptions, build_episode
+    from activeintent.runner import RunSpec, build_episode
 
-    options = RunOptions(method="decide-stop", intention="truth-03", env="symbolic", llm="none", video="none",
+    options = RunSpec.from_options(method="decide-stop", intention="truth-03", env="symbolic", llm="none", video="none",
                          budget=2, seed=1, test_scenes=1, test_pool=0)
     episode = build_episode(options)
     key = episode.intention.goal.key
@@ -198,5 +199,5 @@ def test_the_bench_reads_the_belief_on_a_hidden_goal_without_telling_the_learner
     bits = episode.run().diagnostics["truth_bits"]
     assert len(bits) == 3 and bits[0] == pytest.approx(-np.log2(prior), abs=1e-4)
     assert bits[-1] == pytest.approx(-np.log2(episode.learner.mass_of(key)), abs=1e-4)
-    plain = build_episode(options.model_copy(update={"method": "bayes-stop"})).run()
+    plain = build_episode(options.with_options(method="bayes-stop")).run()
     assert "truth_bits" not in plain.diagnostics

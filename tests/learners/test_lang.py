@@ -7,7 +7,7 @@ import pytest
 
 from activeintent.act.executors import make_executor
 from activeintent.envs.symbolic import SymbolicEnv
-from activeintent.episode import Episode, EpisodeConfig
+from activeintent.episode import Episode
 from activeintent.goals import planner
 from activeintent.goals.facts import facts
 from activeintent.goals.language import NODES, Each, Form, Goal, all_clauses, parse_goal
@@ -16,6 +16,7 @@ from activeintent.learners.lang.hypotheses import GoalIntention, LangSpace
 from activeintent.learners.lang.learner import LangLearner
 from activeintent.learners.lang.space import Compiled
 from activeintent.signals import get_signal
+from activeintent.spec import ProtocolConfig
 from activeintent.users.simulated import SimulatedUser, user_profile
 from activeintent.world import WorldState, apply_plan, apply_skill, layout
 
@@ -144,7 +145,7 @@ def test_posterior_concentrates_on_a_random_true_goal(seed, signal):
     intention = GoalIntention(true)
     user = SimulatedUser(intention, signal, user_profile("exact"), rng=seed)
     Episode(learner, intention, user, make_executor("plan"), SymbolicEnv(),
-            EpisodeConfig(budget=10, seed=seed, test_scenes=3, curve=False)).run()
+            ProtocolConfig(budget=10, seed=seed, test_scenes=3, curve=False)).run()
     w = learner.weights
     names = [h.name for h in learner.hyps]
     i = names.index(true.key)

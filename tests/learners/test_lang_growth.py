@@ -9,12 +9,13 @@ import pytest
 
 from activeintent.act.executors import make_executor
 from activeintent.envs.symbolic import SymbolicEnv
-from activeintent.episode import Episode, EpisodeConfig
+from activeintent.episode import Episode
 from activeintent.goals.language import MAX_CLAUSES, Each, Goal, parse_goal
 from activeintent.learners.bayes.belief import Belief
 from activeintent.learners.lang.hypotheses import GoalIntention, LangSpace
 from activeintent.learners.lang.learner import LangConfig, LangJudge, LangLearner
 from activeintent.learners.lang.proposals import goals_schema, neighbours, to_goal
+from activeintent.spec import ProtocolConfig
 from activeintent.users.simulated import SimulatedUser, user_profile
 
 WARM_LEFT = Each("every", "class", "warm", "region", "left half")
@@ -74,7 +75,7 @@ def test_a_conjunction_left_out_of_the_space_joins_it_scored_on_every_answer():
     intention = GoalIntention(true)
     user = SimulatedUser(intention, "preference", user_profile("exact"), rng=3)
     Episode(learner, intention, user, make_executor("plan"), SymbolicEnv(),
-            EpisodeConfig(budget=10, seed=3, test_scenes=3, curve=False)).run()
+            ProtocolConfig(budget=10, seed=3, test_scenes=3, curve=False)).run()
     names = [h.name for h in learner.hyps]
     assert true.key in names
     assert learner.stats()["neighbours"] > 0
@@ -117,11 +118,11 @@ def test_model_goals_enter_the_belief_with_prior_and_likelihood_only(tmp_path, m
     from chat_server import LANG_GOAL, ChatServer, schema_name
 
     from activeintent.learners.lang.proposals import goals_schema as schema
-    from activeintent.runner import RunOptions, build_episode
+    from activeintent.runner import RunSpec, build_episode
 
     monkeypatch.setenv("OPENAI_API_KEY", "test")
     with ChatServer() as server:
-        opts = RunOptions(method="lang-stop", intention="color-mismatch", env="symbolic", user="exact",
+        opts = RunSpec.from_options(method="lang-stop", intention="color-mismatch", env="symbolic", user="exact",
                           llm="openai:fake", base_url=server.base_url, cache=str(tmp_path / "c.sqlite"),
                           budget=4, test_scenes=2, video="none")
         episode = build_episode(opts, tmp_path / "ep")
@@ -162,11 +163,11 @@ def test_an_episode_does_not_depend_on_the_episodes_run_before_it_in_the_process
     of one episode must not leak into the next: same seeds, same episode, whatever ran before
     (this case differed when they leaked)."""
     from activeintent.protocol import trial_seeds
-    from activeintent.runner import RunOptions, build_episode
+    from activeintent.runner import RunSpec, build_episode
 
     def run(intention: str):
         seed, test_seed = trial_seeds(0, intention, 0)
-        opts = RunOptions(method="lang-stop", intention=intention, env="symbolic", llm="none", budget=5,
+        opts = RunSpec.from_options(method="lang-stop", intention=intention, env="symbolic", llm="none", budget=5,
                           video="none", seed=seed, test_seed=test_seed, prior="uniform")
         r = build_episode(opts).run()
         return r.success_at, r.final_z, r.answers
@@ -182,11 +183,11 @@ def test_a_new_lang_learner_forgets_the_planner_failures_marked_in_the_shared_sp
     checks only, and its episode is the one it would be with a clean space."""
     from activeintent.learners.lang.hypotheses import lang_space
     from activeintent.protocol import trial_seeds
-    from activeintent.runner import RunOptions, build_episode
+    from activeintent.runner import RunSpec, build_episode
 
     shared = lang_space()
     seed, test_seed = trial_seeds(0, "align", 0)
-    opts = RunOptions(method="lang-stop", intention="align", env="symbolic", llm="none", budget=3,
+    opts = RunSpec.from_options(method="lang-stop", intention="align", env="symbolic", llm="none", budget=3,
                       video="none", seed=seed, test_seed=test_seed, prior="uniform", curve=False)
 
     class Rounds(list):

@@ -36,9 +36,10 @@ from activeintent.learners.registry import LearnerContext, get_method
 from activeintent.llm.base import ImagePart
 from activeintent.llm.scripted import ScriptedModel
 from activeintent.records import read_rounds
-from activeintent.runner import RunOptions, build_episode
+from activeintent.runner import RunSpec, build_episode
 from activeintent.signals.preference import PreferenceAnswer
 from activeintent.signals.stop import StopAnswer
+from activeintent.spec import LearnerConfig
 from activeintent.world import PutIn, PutOn, Scene, WorldState, describe_skill, layout
 from helpers import kinematic_trajectory
 
@@ -234,15 +235,15 @@ def test_failure_text_is_said_once_and_test_scene_failures_stay_out_of_the_memor
 def test_variant_is_chosen_by_the_context():
     model = ScriptedModel(respond=respond)
     assert get_method("mllm")(LearnerContext(llm=model)).variant == "faithful"
-    assert get_method("mllm")(LearnerContext(llm=model, variant="structured")).variant == "structured"
+    assert get_method("mllm")(LearnerContext(llm=model, config=LearnerConfig(variant="structured"))).variant == "structured"
     with pytest.raises(ValueError, match="valid variants: faithful, structured"):
-        get_method("mllm")(LearnerContext(llm=model, variant="fancy"))
+        LearnerConfig(variant="fancy")  # refused with the spec, before any learner is built
 
 
 # -- end to end, through a real HTTP server ------------------------------------------------------
 
-def options(server: ChatServer, cache, **extra) -> RunOptions:
-    return RunOptions(method="mllm-llm", intention="color-mismatch", env="symbolic", user="exact", llm="openai:fake",
+def options(server: ChatServer, cache, **extra) -> RunSpec:
+    return RunSpec.from_options(method="mllm-llm", intention="color-mismatch", env="symbolic", user="exact", llm="openai:fake",
                       base_url=server.base_url, cache=str(cache), executor="cap", budget=3, test_scenes=2,
                       video="none", **extra)
 
@@ -353,10 +354,11 @@ def test_bench_preset_table1_runs_the_papers_methods_beside_its_rows(tmp_path, m
 
 def test_resuming_a_folder_made_before_variants_existed(tmp_path):
     from activeintent.bench.runner import _check_same_settings
-    from activeintent.bench.work import BenchOptions
+    from activeintent.bench.work import BenchConfig
 
-    old = BenchOptions(methods=["bayes-stop"], intentions=["stack"], run=RunOptions(video="none"))
+    old = BenchConfig(methods=["bayes-stop"], intentions=["stack"], run=RunSpec.from_options(video="none"))
     data = json.loads(old.model_dump_json())
+    data["run"] = old.run.options()  # format 1: flat option names, without the options added since
     for key in ("variant", "early_threshold"):
         data["run"].pop(key)
     (tmp_path / "bench.json").write_text(json.dumps(data))
@@ -365,7 +367,7 @@ def test_resuming_a_folder_made_before_variants_existed(tmp_path):
     (tmp_path / "bench.json").write_text(json.dumps(data))
     with pytest.raises(ValueError, match="other settings"):  # the old folder ran the structured variant
         _check_same_settings(old.model_copy(update={"methods": ["mllm"]}), tmp_path / "bench.json")
-    structured = old.model_copy(update={"methods": ["mllm"], "run": RunOptions(video="none", variant="structured")})
+    structured = old.model_copy(update={"methods": ["mllm"], "run": RunSpec.from_options(video="none", variant="structured")})
     _check_same_settings(structured, tmp_path / "bench.json")
 
 

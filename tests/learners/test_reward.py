@@ -15,7 +15,7 @@ from activeintent.learners.reward.features import FEATURE_NAMES, N_FEATURES, phi
 from activeintent.learners.reward.learner import RewardConfig, RewardLearner
 from activeintent.learners.reward.models import RewardObservation, preference_probs, prefix_probs
 from activeintent.records import read_rounds
-from activeintent.runner import RunOptions, build_episode
+from activeintent.runner import RunSpec, build_episode
 from activeintent.signals import get_signal
 from activeintent.suites import SUITE_NAMES, suite
 from activeintent.world import WorldState, layout
@@ -101,7 +101,7 @@ def test_the_methods_are_registered():
 @pytest.mark.parametrize("method", ["reward-stop", "reward-preference-noplanner"])
 def test_same_seed_same_episode(tmp_path, method):
     def once(out, seed=9):
-        build_episode(RunOptions(method=method, intention="color-mismatch", env="symbolic", llm="none",
+        build_episode(RunSpec.from_options(method=method, intention="color-mismatch", env="symbolic", llm="none",
                                  video="none", budget=3, seed=seed), out).run()
         rounds = read_rounds(out / "rounds.jsonl")
         for r in rounds:

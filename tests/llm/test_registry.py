@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import pytest
 from fault_server import FaultServer, Ok
-from pydantic import ValidationError
 
 from activeintent.llm.accounting import CallRecord, Usage
 from activeintent.llm.base import Message
 from activeintent.llm.registry import load_model, parse_spec
-from activeintent.runner import Models, RunOptions, check_options
+from activeintent.runner import Models, RunSpec, check_spec
 
 
 @pytest.mark.parametrize(
@@ -37,18 +36,18 @@ def test_bad_spec_lists_valid_forms(spec):
 
 def test_run_options_refuse_bad_model_options_clearly():
     with pytest.raises(ValueError, match="openai:<model-name>"):
-        check_options(RunOptions(method="preference", llm="gpt4"))
+        check_spec(RunSpec.from_options(method="preference", llm="gpt4"))
     with pytest.raises(ValueError, match="openai:<model-name>"):
-        check_options(RunOptions(method="bayes-stop", llm="none", vlm="gpt4"))
-    with pytest.raises(ValidationError, match="record"):
-        RunOptions(cache_mode="replay-only")
+        check_spec(RunSpec.from_options(method="bayes-stop", llm="none", vlm="gpt4"))
+    with pytest.raises(ValueError, match="--cache-mode: .*record"):
+        RunSpec.from_options(cache_mode="replay-only")
 
 
 def test_a_runs_models_share_the_cache_and_count_usage_together(tmp_path):
     with FaultServer() as server:
         server.default = Ok("fine")
-        models = Models(RunOptions(llm="openai:text-model", vlm="openai:vision-model",
-                                   base_url=server.base_url, cache=str(tmp_path / "c.sqlite")))
+        models = Models(RunSpec.from_options(llm="openai:text-model", vlm="openai:vision-model",
+                                             base_url=server.base_url, cache=str(tmp_path / "c.sqlite")).models)
         assert models.llm is not models.vlm
         user = [Message(role="user", content="hi")]
         models.llm.chat(user)
@@ -57,7 +56,7 @@ def test_a_runs_models_share_the_cache_and_count_usage_together(tmp_path):
         assert [r["model"] for r in server.requests] == ["text-model", "vision-model"]
         assert models.usage()[0] == 3  # calls, over both models
 
-        same = Models(RunOptions(llm="openai:m", vlm="openai:m", base_url=server.base_url, cache_mode="off"))
+        same = Models(RunSpec.from_options(llm="openai:m", vlm="openai:m", base_url=server.base_url, cache_mode="off").models)
         assert same.llm is same.vlm
 
 

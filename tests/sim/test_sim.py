@@ -339,9 +339,9 @@ def test_save_load_roundtrip(demo, tmp_path):
 def test_a_stopped_round_video_ends_at_the_stop_with_a_marker(tmp_path):
     import imageio.v2 as iio
 
-    from activeintent.runner import RunOptions, build_episode
+    from activeintent.runner import RunSpec, build_episode
 
-    build_episode(RunOptions(method="bayes-stop", intention="stack", env="pybullet", llm="none", user="exact",
+    build_episode(RunSpec.from_options(method="bayes-stop", intention="stack", env="pybullet", llm="none", user="exact",
                              video="all", budget=1, test_scenes=1, seed=2), tmp_path).run()
     from activeintent.records import read_rounds
 

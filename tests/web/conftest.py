@@ -14,6 +14,7 @@ import httpx
 import pytest
 
 from activeintent.learners.registry import get_method
+from activeintent.spec import OPTIONS, RunSpec
 from activeintent.web.limits import Limits, SessionLimits
 from activeintent.web.server import create_app, runner_builder
 from activeintent.web.session import SessionManager, StudyConfig
@@ -68,6 +69,14 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
+def study_config(method: str, budget: int, out: Path, **fields) -> StudyConfig:
+    """A study of ``method`` (Bayesian methods: no model; 2 test scenes); ``fields`` are the
+    spec's options (e.g. intention) or the study's own (e.g. show_estimate)."""
+    run = {k: fields.pop(k) for k in list(fields) if k in OPTIONS}
+    spec = RunSpec.from_options(method=method, budget=budget, llm="none", test_scenes=2, **run)
+    return StudyConfig(run=spec, signal=get_method(method).signal, out_dir=out, **fields)
+
+
 @pytest.fixture
 def live_server(tmp_path) -> Iterator:
     """``start(method, rounds=2, limits=None, clock=None, **study)`` serves a study on
@@ -77,17 +86,17 @@ def live_server(tmp_path) -> Iterator:
     def start(method: str, rounds: int = 2, limits: Limits | dict | None = None, clock=None, study_file=None,
               **study) -> LiveServer:
         out = tmp_path / f"out-{len(servers)}"
-        config = StudyConfig(method=method, signal=get_method(method).signal, rounds=rounds, out_dir=out, **study)
+        config = study_config(method, rounds, out, **study)
         if isinstance(limits, dict):
             limits = Limits(**limits)
         conditions = None
         if study_file is not None:  # a study file's conditions (method, rule, guess display)
             conditions = {}
             for c in study_file.conditions:
-                cfg = StudyConfig(method=c.method, signal=get_method(c.method).signal, rounds=rounds, out_dir=out,
-                                  intention=c.intention, show_estimate=c.show_estimate, **study)
-                conditions[c.name] = (cfg, runner_builder(cfg, llm="none", test_scenes=2))
-        app = create_app(config, runner_builder(config, llm="none", test_scenes=2),  # Bayesian methods, no model
+                cfg = study_config(c.method, rounds, out, **{**study, "intention": c.intention,
+                                                             "show_estimate": c.show_estimate})
+                conditions[c.name] = (cfg, runner_builder(cfg))
+        app = create_app(config, runner_builder(config),
                          limits=limits, clock=clock or time.monotonic, study=study_file, conditions=conditions)
         port = _free_port()
         # the server `activeintent serve` runs: uvicorn inside the connection guard

@@ -38,7 +38,7 @@ def test_serve_names_the_design_and_configures_the_study(tmp_path, monkeypatch):
     said = " ".join(res.output.split())  # the console wraps long lines
     assert "free rule" in said and "not scored" in said and "color-match" not in said
     free = served[-1].state.manager.config
-    assert free.design == "free-rule" and free.intention is None and free.show_estimate == "hidden"
+    assert free.design == "free-rule" and free.intention_name is None and free.show_estimate == "hidden"
     assert free.video_size == (800, 600)  # every block at least 40 px (tests/sim/test_camera.py)
     assert "model none" in said  # a method that needs no model gets none unless --llm is given
     bad = runner.invoke(app, ["serve", "--method", "bayes-stop", "--video-size", "800x", "--out", str(tmp_path)])
@@ -51,14 +51,15 @@ def test_serve_names_the_design_and_configures_the_study(tmp_path, monkeypatch):
     said = " ".join(res.output.split())
     assert "assigned rule color-match" in said and "Put each block in the bowl of the same colour." in said
     assigned = served[-1].state.manager.config
-    assert assigned.design == "assigned-rule" and assigned.intention == "color-match"
+    assert assigned.design == "assigned-rule" and assigned.intention_name == "color-match"
     assert assigned.show_estimate == "after-answer" and assigned.video_size == (360, 360)
     from pydantic import ValidationError
 
+    from activeintent.spec import RunSpec
     from activeintent.web.session import StudyConfig
 
     with pytest.raises(ValidationError, match="64-2048"):  # a study built in Python keeps the CLI's rule
-        StudyConfig(method="bayes-stop", signal="stop", rounds=3, video_size=(32, 4000))
+        StudyConfig(run=RunSpec.from_options(method="bayes-stop", budget=3), signal="stop", video_size=(32, 4000))
 
 
 def test_serve_binds_loopback_and_answers(tmp_path):

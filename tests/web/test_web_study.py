@@ -15,22 +15,27 @@ import pytest
 from typer.testing import CliRunner
 
 from activeintent.cli import app
+from activeintent.spec import RunSpec
 from activeintent.web.export import collect_sessions, session_record, write_table
 from activeintent.web.session import StudyConfig, guess_of, scene_legend, study_summary
 
 
+def stop_study(budget: int, **user) -> StudyConfig:
+    return StudyConfig(run=RunSpec.from_options(method="bayes-stop", budget=budget, **user), signal="stop")
+
+
 # -- unit tests (no server) ---------------------------------------------------------------------
 def test_study_defaults_free_rule_hidden_guess_and_readable_videos():
-    config = StudyConfig(method="bayes-stop", signal="stop", rounds=2)
-    assert config.design == "free-rule" and config.intention is None and config.intention_description is None
+    config = stop_study(2)
+    assert config.design == "free-rule" and config.intention_name is None and config.intention_description is None
     assert config.show_estimate == "hidden"
     assert config.video_size == (800, 600)  # every block at least 40 px (tests/sim/test_camera.py)
     assert json.loads(config.model_dump_json())["design"] == "free-rule"  # recorded in session.json
-    assigned = StudyConfig(method="bayes-stop", signal="stop", rounds=2, intention="color-match")
-    assert assigned.design == "assigned-rule"
+    assigned = stop_study(2, intention="color-match")
+    assert assigned.design == "assigned-rule" and assigned.intention_name == "color-match"
     assert assigned.intention_description == "Put each block in the bowl of the same colour."
     with pytest.raises(ValueError):
-        StudyConfig(method="bayes-stop", signal="stop", rounds=2, show_estimate="sometimes")
+        StudyConfig(run=RunSpec.from_options(method="bayes-stop", budget=2), signal="stop", show_estimate="sometimes")
 
 
 def _summary() -> dict:
@@ -41,15 +46,14 @@ def _summary() -> dict:
 
 
 def test_a_free_rule_summary_scores_nothing_an_assigned_one_keeps_its_score():
-    free = study_summary(_summary(), StudyConfig(method="bayes-stop", signal="stop", rounds=1))
+    free = study_summary(_summary(), stop_study(1))
     assert free["success"] is None and free["success_basis"] == "none" and free["design"] == "free-rule"
     assert free["intention"] is None and free["success_at"] == [None, None]
     assert free["success_physics"] is None and free["test_excluded"] is None
     assert free["tests"][0]["success"] is None and free["tests"][0]["feasible"] is None
     assert free["tests"][0]["z"] == "z" and free["final_z"] == "z"  # the learner's side stays
     assert "color-match" not in json.dumps(free)
-    assigned = study_summary(_summary(), StudyConfig(method="bayes-stop", signal="stop", rounds=1,
-                                                     intention="color-match"))
+    assigned = study_summary(_summary(), stop_study(1, intention="color-match"))
     assert assigned["success"] == 0.5 and assigned["success_basis"] == "assigned-rule"
 
 

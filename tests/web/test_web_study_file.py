@@ -9,6 +9,7 @@ from collections import Counter
 import pytest
 from fastapi.testclient import TestClient
 
+from activeintent.spec import RunSpec
 from activeintent.web.server import create_app
 from activeintent.web.session import StudyConfig
 from activeintent.web.study import (
@@ -72,7 +73,8 @@ def _study(**extra) -> StudyFile:
 
 
 def _app(tmp_path, study: StudyFile):
-    config = StudyConfig(method="bayes-preference", signal="preference", rounds=1, out_dir=tmp_path)
+    config = StudyConfig(run=RunSpec.from_options(method="bayes-preference", budget=1), signal="preference",
+                         out_dir=tmp_path)
 
     def never(*_):  # no episode is needed: every request here is refused before one starts
         raise AssertionError("a refused session must not start an episode")

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from activeintent.bench.work import BenchOptions, WorkItem
+    from activeintent.bench.work import BenchConfig, WorkItem
 
 BACKENDS = ("local", "ray")
 
@@ -42,7 +42,7 @@ def check_backend(name: str) -> None:
             raise ValueError("--backend ray needs Ray: pip install 'activeintent[ray]'")
 
 
-def worker_died(item: WorkItem, options: BenchOptions, why: str = "worker process died") -> dict:
+def worker_died(item: WorkItem, options: BenchConfig, why: str = "worker process died") -> dict:
     """The record of an episode whose worker ended without an answer (e.g. a native crash)."""
     from activeintent.bench.work import protocol_fields
 
@@ -55,12 +55,12 @@ def forwarded_env() -> dict[str, str]:
             if k in FORWARDED_NAMES or k.startswith(FORWARDED_PREFIXES)}
 
 
-def ray_address(options: BenchOptions) -> str | None:
+def ray_address(options: BenchConfig) -> str | None:
     """--ray-address, else RAY_ADDRESS; None: start a Ray of our own on this machine."""
     return options.ray_address or os.environ.get("RAY_ADDRESS") or None
 
 
-def _start_ray(options: BenchOptions) -> bool:
+def _start_ray(options: BenchConfig) -> bool:
     """Connect (or start) Ray; True when this call did, so the caller shuts it down again."""
     import ray
 
@@ -78,7 +78,7 @@ def _start_ray(options: BenchOptions) -> bool:
     return True
 
 
-def execute_ray(todo: list[WorkItem], options: BenchOptions, out: Path) -> Iterator[dict]:
+def execute_ray(todo: list[WorkItem], options: BenchConfig, out: Path) -> Iterator[dict]:
     """Yield one record per episode of ``todo``, in the order they finish."""
     import ray
     from ray.exceptions import RayError, RayTaskError

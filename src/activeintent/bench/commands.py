@@ -81,8 +81,8 @@ def bench(
     from activeintent.bench.backends import check_backend
     from activeintent.bench.report import plot_success_vs_signals, write_report
     from activeintent.bench.runner import run_bench
-    from activeintent.bench.work import BenchOptions, protocol_fields
-    from activeintent.runner import check_options
+    from activeintent.bench.work import BenchConfig, protocol_fields
+    from activeintent.runner import check_spec
     from activeintent.suites import resolve
     from activeintent.suites import suite as suite_names
 
@@ -93,13 +93,13 @@ def bench(
             methods, suite, preset_trials = _apply_preset(preset, methods, intentions, budget)
             trials = trials or preset_trials
         trials = trials or 20
-        run = opt.run_options(plugins=plugin, budget=budget, test_scenes=test_scenes, test_pool=test_pool, env=env, user=user,
-                              new_scene=new_scene, prior=prior, llm=llm, vlm=vlm, base_url=base_url, cache=cache,
-                              cache_mode=cache_mode, executor=executor, retriever=retriever, variant=variant,
-                              epsilon=epsilon, early_threshold=early_threshold, curve=curve, video="none")
+        run = opt.run_spec(plugins=plugin, budget=budget, test_scenes=test_scenes, test_pool=test_pool, env=env, user=user,
+                           new_scene=new_scene, prior=prior, llm=llm, vlm=vlm, base_url=base_url, cache=cache,
+                           cache_mode=cache_mode, executor=executor, retriever=retriever, variant=variant,
+                           epsilon=epsilon, early_threshold=early_threshold, curve=curve, video="none")
         method_list = _split(methods) or ["bayes-preference", "bayes-stop", "zero-signal", "random-query"]
         for m in method_list:
-            check_options(run.model_copy(update={"method": m}))
+            check_spec(run.with_options(method=m))
         if suite is None:  # the paper suite only when nothing else says what to run
             suite = "" if intentions or intention_file else "paper"
         intention_list = _split(intentions) or [i for s in _split(suite) for i in suite_names(s)]
@@ -117,7 +117,7 @@ def bench(
         raise typer.Exit(2) from None
     if opt.check_only():
         return
-    options = BenchOptions(methods=method_list, intentions=intention_list, intention_files=list(intention_file or []),
+    options = BenchConfig(methods=method_list, intentions=intention_list, intention_files=list(intention_file or []),
                            trials=trials, seed=seed, jobs=jobs, backend=backend, ray_address=ray_address,
                            retry_errors=retry_errors,
                            keep_episodes=keep_episodes, run=run)

@@ -30,7 +30,7 @@ def perf_bench(
 ) -> None:
     """Time per phase and per episode of fixed `run`-like episodes (no video, no model), and the
     learner's time per signal (choosing the query, reading the answer; scoring excluded)."""
-    from activeintent.runner import RunOptions, build_episode
+    from activeintent.runner import RunSpec, build_episode
 
     class RoundTimes:
         def __init__(self) -> None:
@@ -54,7 +54,7 @@ def perf_bench(
         walls, phases, rounds = [], [], RoundTimes()
         for name in names:
             for seed in range(episodes):
-                options = RunOptions(method=method, intention=name, env=env, llm="none", video="none", seed=seed,
+                options = RunSpec.from_options(method=method, intention=name, env=env, llm="none", video="none", seed=seed,
                                      budget=budget)
                 start = time.perf_counter()
                 episode = build_episode(options)

@@ -25,12 +25,12 @@ from multiprocessing import get_context
 from pathlib import Path
 
 from activeintent.bench.work import (
-    BenchOptions,
+    BenchConfig,
     WorkItem,
     bench_json,
     protocol_fields,
     run_item,
-    write_bench_options,
+    write_bench_config,
 )
 from activeintent.learners.registry import PAPER_METHODS
 from activeintent.results import (
@@ -43,14 +43,14 @@ from activeintent.results import (
 )
 
 
-def run_bench(options: BenchOptions, out: Path, on_done: Callable[[dict, int, int], None] | None = None,
+def run_bench(options: BenchConfig, out: Path, on_done: Callable[[dict, int, int], None] | None = None,
               on_rejected: Callable[[list[Rejected], Path], None] | None = None) -> list[dict]:
     """Run what is missing from ``out/results.jsonl``; returns all records. ``on_rejected`` hears
     of the lines set aside into ``rejected.jsonl`` (never counted, never fatal)."""
     with hold_results_folder(out):
         results_path = out / "results.jsonl"
         _check_same_settings(options, out / "bench.json")
-        write_bench_options(options, out / "bench.json")
+        write_bench_config(options, out / "bench.json")
         loaded = load_results(results_path)
         rejected_file = set_aside_rejected(results_path, loaded)
         if rejected_file is not None and on_rejected:
@@ -79,7 +79,7 @@ def run_bench(options: BenchOptions, out: Path, on_done: Callable[[dict, int, in
 _SETTINGS = ("seed", "run")  # methods, intentions and trials may grow on resume; these may not change
 
 
-def _check_same_settings(options: BenchOptions, path: Path) -> None:
+def _check_same_settings(options: BenchConfig, path: Path) -> None:
     """Resuming into a folder made with other settings would mix incomparable episodes."""
     if not path.exists():
         return
@@ -87,8 +87,8 @@ def _check_same_settings(options: BenchOptions, path: Path) -> None:
     now = json.loads(options.model_dump_json())
     if isinstance(before.get("run"), dict):
         if not any(m in PAPER_METHODS for m in before.get("methods", []) + now["methods"]):
-            before["run"].pop("variant", None)  # only the paper's methods have variants
-            now["run"].pop("variant", None)
+            for settings in (before, now):  # only the paper's methods have variants
+                settings["run"]["learner"].pop("variant", None)
     changed = [k for k in _SETTINGS if before.get(k) != now.get(k)]
     if changed:
         diff = "; ".join(f"{k}: {before.get(k)} → {now.get(k)}" for k in changed)
@@ -96,7 +96,7 @@ def _check_same_settings(options: BenchOptions, path: Path) -> None:
                          "Use another --out, or the same settings to resume.")
 
 
-def _execute(todo: list[WorkItem], options: BenchOptions, out: Path) -> Iterator[dict]:
+def _execute(todo: list[WorkItem], options: BenchConfig, out: Path) -> Iterator[dict]:
     if options.backend == "ray":
         from activeintent.bench.backends import execute_ray
 

@@ -57,7 +57,6 @@ from pathlib import Path
 
 import numpy as np
 
-from activeintent.episode import EpisodeSeeds
 from activeintent.goals.facts import facts
 from activeintent.goals.language import (
     MAX_CLAUSES,
@@ -76,6 +75,7 @@ from activeintent.protocol import (
     draw_test_scenes,
     trial_seeds,
 )
+from activeintent.spec import EpisodeSeeds
 from activeintent.world import Scene, WorldState, layout
 
 PATH = Path(__file__).with_name("truth_goals.json")

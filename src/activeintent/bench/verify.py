@@ -68,13 +68,13 @@ def sample_records(records: list[dict], sample: int) -> list[dict]:
 
 def verify(folder: Path, sample: int, methods: list[str] | None = None) -> list[dict]:
     """Differences between recorded and re-run episodes (empty when they agree)."""
-    from activeintent.bench.work import WorkItem, read_bench_options, run_item
+    from activeintent.bench.work import WorkItem, read_bench_config, run_item
     from activeintent.results import read_results
 
     note = folder / NOT_VERIFIED
     if note.is_file():
         raise StaleFolder(f"{folder} cannot be verified: {note.read_text().strip().splitlines()[0].lstrip('# ')}")
-    options = read_bench_options(folder / "bench.json")
+    options = read_bench_config(folder / "bench.json")
     records = [r for r in read_results(folder / "results.jsonl") if not r.get("error")]
     old = sorted({r.get("format") for r in records if r.get("format") != FORMAT_VERSION}, key=str)
     if old:

@@ -10,7 +10,7 @@ from pathlib import Path
 from pydantic import BaseModel, Field
 
 from activeintent.protocol import trial_seeds
-from activeintent.runner import RunOptions
+from activeintent.spec import RunSpec
 
 
 class WorkItem(BaseModel):
@@ -28,7 +28,10 @@ class WorkItem(BaseModel):
         return f"{self.method}/{name}/trial{self.trial}"
 
 
-class BenchOptions(BaseModel):
+class BenchConfig(BaseModel):
+    """A benchmark: ``run`` (the spec every episode shares; each item sets its method, intention
+    and seeds) × methods × intentions × trials, and how they are executed (jobs, backend)."""
+
     methods: list[str]
     intentions: list[str] = Field(default_factory=list)
     intention_files: list[str] = Field(default_factory=list)
@@ -39,16 +42,17 @@ class BenchOptions(BaseModel):
     ray_address: str | None = None  # with backend ray: an existing cluster (else RAY_ADDRESS, else a local Ray)
     retry_errors: bool = False
     keep_episodes: bool = False  # per-episode folders (rounds.jsonl, summary.json)
-    run: RunOptions = Field(default_factory=lambda: RunOptions(video="none"))
+    run: RunSpec = Field(default_factory=lambda: RunSpec.from_options(video="none"))
 
     def items(self) -> list[WorkItem]:
         names = list(self.intentions) + list(self.intention_files)
         return [WorkItem(method=m, intention=i, trial=t) for t in range(self.trials) for i in names for m in self.methods]
 
 
-# bench.json's format. 2: it says its format. 1 (no "format"): options added since take the
-# values they had in effect then (legacy_run).
-BENCH_FORMAT = 2
+# bench.json's format. 3: ``run`` is a RunSpec (sections). 2: it says its format; ``run`` in flat
+# option names. 1 (no "format"): options added since take the values they had in effect then
+# (legacy_run).
+BENCH_FORMAT = 3
 
 
 def legacy_run(run: dict) -> dict:
@@ -66,37 +70,39 @@ def bench_json(path: Path) -> dict:
     if not isinstance(version, int) or version > BENCH_FORMAT:
         raise ValueError(f"{path} is bench.json format {version!r}; this code reads formats 1 to {BENCH_FORMAT}: "
                          "update activeintent")
-    if version == 1 and isinstance(data.get("run"), dict):
-        data["run"] = {**legacy_run(data["run"]), **data["run"]}
+    run = data.get("run")
+    if version < 3 and isinstance(run, dict):
+        if version == 1:
+            run = {**legacy_run(run), **run}
+        data["run"] = RunSpec.from_options(**run).model_dump(mode="json")
     return data
 
 
-def read_bench_options(path: Path) -> BenchOptions:
+def read_bench_config(path: Path) -> BenchConfig:
     """The options a results folder was made with (its bench.json, of any format)."""
-    return BenchOptions.model_validate(bench_json(path))
+    return BenchConfig.model_validate(bench_json(path))
 
 
-def write_bench_options(options: BenchOptions, path: Path) -> None:
+def write_bench_config(options: BenchConfig, path: Path) -> None:
     path.write_text(json.dumps({"format": BENCH_FORMAT, **json.loads(options.model_dump_json())}, indent=2))
 
 
-def protocol_fields(run: RunOptions) -> dict:
+def protocol_fields(run: RunSpec) -> dict:
     """What every results line records about how it was measured."""
-    return {"env": run.env, "user_preset": run.user, "budget": run.budget, "new_scene": run.new_scene,
-            "prior": run.prior, "test_scenes": run.test_scenes, "test_pool": run.test_pool, "llm": run.llm, "executor": run.executor,
-            "vlm": run.vlm, "retriever": run.retriever, "variant": run.variant}
+    p, learner = run.protocol, run.learner
+    return {"env": run.env.name, "user_preset": run.user.preset, "budget": p.budget, "new_scene": p.new_scene,
+            "prior": learner.prior, "test_scenes": p.test_scenes, "test_pool": p.test_pool, "llm": run.models.llm,
+            "executor": learner.executor, "vlm": run.models.vlm, "retriever": learner.retriever,
+            "variant": learner.variant}
 
 
-def run_item(item: WorkItem, options: RunOptions, bench_seed: int, out: str, keep: bool) -> dict:
+def run_item(item: WorkItem, options: RunSpec, bench_seed: int, out: str, keep: bool) -> dict:
     """One episode in a worker process (own simulator client, own model handles)."""
     user_defined = ".py:" in item.intention
     seed, test_seed = trial_seeds(bench_seed, item.intention, item.trial)
-    run = options.model_copy(update={
-        "method": item.method,
-        "intention": None if user_defined else item.intention,
-        "intention_file": item.intention if user_defined else None,
-        "seed": seed, "test_seed": test_seed,
-    })
+    run = options.with_options(method=item.method, intention=None if user_defined else item.intention,
+                               intention_file=item.intention if user_defined else None,
+                               seed=seed, test_seed=test_seed)
     base = {"method": item.method, "intention": item.intention, "trial": item.trial, **protocol_fields(run)}
     try:
         from activeintent.runner import build_episode

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from pydantic import BaseModel, Field
 
 from activeintent.llm.base import ChatModel
 from activeintent.signals import Answer
+from activeintent.spec import LearnerConfig
 from activeintent.world import Scene, Skill, WorldState
 from activeintent.world.trajectory import Trajectory
 
@@ -90,17 +91,13 @@ class Learner(ABC):
 
 @dataclass
 class LearnerContext:
-    """Everything a method may need to build its learner (from the run's options)."""
+    """Everything a method may need to build its learner: the models, the learner's own random
+    stream (EpisodeSeeds.learner, not the episode's seed) and the spec's learner section."""
 
     llm: ChatModel | None = None
     vlm: ChatModel | None = None
-    retriever: str = "symbolic"
-    learner_seed: int = 0  # the learner's own random stream (EpisodeSeeds.learner), not the episode's seed
-    design_scenes: bool = True
-    epsilon: float = 2.0
-    prior: str = "length"
-    variant: str = "faithful"  # the paper's methods: faithful (as the paper ran them) | structured
-    early_threshold: float | None = None  # eq. 3: a stop before this many seconds shows no I_b (None: ε)
+    learner_seed: int = 0
+    config: LearnerConfig = field(default_factory=LearnerConfig)
 
 
 @dataclass

@@ -24,39 +24,33 @@ def _bayes(signal: str, kind: str = "eig") -> Callable[[LearnerContext], Learner
         )
 
         cls = {"eig": BayesLearner, "random": RandomQueryLearner, "zero": ZeroSignalLearner}[kind]
-        return cls(signal, rng=ctx.learner_seed, llm=ctx.llm, config=BayesConfig(prior=ctx.prior))  # type: ignore[arg-type]
+        return cls(signal, rng=ctx.learner_seed, llm=ctx.llm, config=BayesConfig(prior=ctx.config.prior))  # type: ignore[arg-type]
 
     return build
 
 
-VARIANTS = ("faithful", "structured")
-
-
 def _paper(kind: str) -> Callable[[LearnerContext], Learner]:
     def build(ctx: LearnerContext) -> Learner:
-        if ctx.variant not in VARIANTS:
-            raise ValueError(f"Unknown variant {ctx.variant!r}; valid variants: {', '.join(VARIANTS)}.")
-        if kind == "mllm-llm" and ctx.retriever not in ("vision", "symbolic"):
-            raise ValueError(f"Unknown retriever {ctx.retriever!r}; valid retrievers: vision, symbolic.")
-        if ctx.variant == "faithful":
+        # variant and retriever were validated with the spec (spec.LearnerConfig)
+        if ctx.config.variant == "faithful":
             from activeintent.learners.paper import faithful as f
 
-            cfg = f.FaithfulConfig(design_scenes=ctx.design_scenes, epsilon=ctx.epsilon,
-                                   early_threshold=ctx.early_threshold, seed=ctx.learner_seed)
+            cfg = f.FaithfulConfig(design_scenes=ctx.config.design_scenes, epsilon=ctx.config.epsilon,
+                                   early_threshold=ctx.config.early_threshold, seed=ctx.learner_seed)
             if kind == "preference":
                 return f.FaithfulPreferenceLearner(ctx.llm, cfg)  # type: ignore[arg-type]
             if kind == "mllm":
                 return f.FaithfulMllmLearner(ctx.vlm or ctx.llm, cfg)  # type: ignore[arg-type]
-            return f.FaithfulMllmLlmLearner(ctx.llm, ctx.vlm, retriever=ctx.retriever, config=cfg)  # type: ignore[arg-type]
+            return f.FaithfulMllmLlmLearner(ctx.llm, ctx.vlm, retriever=ctx.config.retriever, config=cfg)  # type: ignore[arg-type]
         from activeintent.learners.paper import structured as p
 
-        config = p.PaperLearnerConfig(design_scenes=ctx.design_scenes, epsilon=ctx.epsilon,
-                                      early_threshold=ctx.early_threshold)
+        config = p.PaperLearnerConfig(design_scenes=ctx.config.design_scenes, epsilon=ctx.config.epsilon,
+                                      early_threshold=ctx.config.early_threshold)
         if kind == "preference":
             return p.PreferenceLearner(ctx.llm, config)  # type: ignore[arg-type]
         if kind == "mllm":
             return p.MllmLearner(ctx.vlm or ctx.llm, config)  # type: ignore[arg-type]
-        return p.MllmLlmLearner(ctx.llm, ctx.vlm, retriever=ctx.retriever, config=config)  # type: ignore[arg-type]
+        return p.MllmLlmLearner(ctx.llm, ctx.vlm, retriever=ctx.config.retriever, config=config)  # type: ignore[arg-type]
 
     return build
 
@@ -140,5 +134,5 @@ def make_learner(name: str, ctx: LearnerContext) -> Learner:
     return get_method(name)(ctx)
 
 
-__all__ = ["BASELINES", "METHODS", "PAPER_METHODS", "VARIANTS", "LearnerContext", "Method", "UnknownName",
+__all__ = ["BASELINES", "METHODS", "PAPER_METHODS", "LearnerContext", "Method", "UnknownName",
            "check_method", "get_method", "make_learner", "method_names"]

@@ -68,7 +68,7 @@ def serve(
 
     from activeintent.intentions.registry import IntentionError
     from activeintent.learners.registry import get_method
-    from activeintent.runner import check_options
+    from activeintent.runner import check_spec
     from activeintent.suites import resolve as resolve_intention
     from activeintent.web import transport
     from activeintent.web.limits import Limits
@@ -100,19 +100,19 @@ def serve(
     for name, m, rule_name, rule_file, shown in cells:
         try:
             models[name] = llm or ("embedded" if get_method(m).needs_llm else "none")
-            # options and the assigned rule are checked now so a typo fails before anyone opens the page
-            check_options(opt.run_options(method=m, budget=rounds, intention=rule_name,
-                                          intention_file=rule_file, llm=models[name], **extra))
+            # the spec and the assigned rule are checked now so a typo fails before anyone opens the page
+            run = opt.run_spec(method=m, budget=rounds, intention=rule_name, intention_file=rule_file,
+                               llm=models[name], seed=seed, **extra)
+            check_spec(run)
             rule = resolve_intention(rule_name, rule_file) if rule_name or rule_file else None
             signal = page_signal(get_method(m).signal).name
+            configs[name] = StudyConfig(
+                run=run, signal=signal, intention_name=rule.name if rule else None,
+                intention_description=(rule.description or rule.name) if rule else None, show_estimate=shown,
+                video_size=size, out_dir=out, answer_timeout=answer_timeout, max_sessions=max_sessions)
         except (ValueError, IntentionError, FileNotFoundError) as err:
             where = f"condition {name}: " if study_file else ""
             raise typer.BadParameter(where + str(err)) from None
-        configs[name] = StudyConfig(
-            method=m, signal=signal, rounds=rounds, intention=rule.name if rule else None, intention_file=rule_file,
-            intention_description=(rule.description or rule.name) if rule else None, show_estimate=shown,
-            video_size=size, out_dir=out, seed=seed, answer_timeout=answer_timeout,
-            max_sessions=max_sessions)
     config = next(iter(configs.values()))
     limits = Limits(max_sessions_per_client=max_sessions_per_client,
                     max_new_sessions_per_hour=max_new_sessions_per_hour, idle_timeout=idle_timeout * 60,
@@ -121,11 +121,11 @@ def serve(
                     max_connections_per_client=max_connections_per_client, max_connections=max_connections)
     if opt.check_only():
         return
-    conditions = ({name: (c, runner_builder(c, llm=models[name], **extra)) for name, c in configs.items()}
+    conditions = ({name: (c, runner_builder(c)) for name, c in configs.items()}
                   if study_file else None)
     first = next(iter(configs))
     try:
-        app = create_app(config, runner_builder(config, llm=models[first], **extra), limits=limits, study=study_file,
+        app = create_app(config, runner_builder(config), limits=limits, study=study_file,
                          conditions=conditions)
     except ValueError as err:  # e.g. an unreadable OUT/assignment.json
         raise typer.BadParameter(str(err), param_hint="--out") from None
@@ -135,8 +135,8 @@ def serve(
         console.print(f"[bold]activeintent study[/] from {study}: {len(configs)} conditions, {rounds} rounds; "
                       f"sessions saved in {out}/")
         for name, c in configs.items():
-            console.print(f"  {name}: {c.method} ({c.signal}), {c.design} "
-                          f"{c.intention or ''}, guess {c.show_estimate}, model {models[name]}")
+            console.print(f"  {name}: {c.run.learner.method} ({c.signal}), {c.design} "
+                          f"{c.intention_name or ''}, guess {c.show_estimate}, model {models[name]}")
         console.print("Participants are assigned to the least-filled condition (counts in "
                       f"{out}/assignment.json); a participant ID is "
                       + ("required" if study_file.require_pid else "optional") + " (?pid=… or ?PROLIFIC_PID=…).")
@@ -145,8 +145,8 @@ def serve(
             console.print(f"[yellow]Listening on {host}: anyone who can reach this address can take part.[/]")
         transport.serve(app, host=host, port=port)
         return
-    signal, rule = config.signal, config.intention
-    method = config.method
+    signal, rule = config.signal, config.intention_name
+    method = config.run.learner.method
     console.print(f"[bold]activeintent study[/]: {method} ({signal} signal), {rounds} rounds; "
                   f"sessions saved in {out}/")
     if rule is not None:

@@ -75,12 +75,23 @@ def _status(info: dict, folder: Path, events: list[dict]) -> str:
     return "finished" if (folder / "summary.json").exists() else "incomplete"
 
 
+def study_fields(study: dict) -> dict:
+    """A session.json's study as the fields exports read (a versioned reader: sessions written
+    before the study held a run spec kept method, rounds and intention flat)."""
+    run = study.get("run")
+    if not isinstance(run, dict):
+        return study
+    learner, protocol = run.get("learner") or {}, run.get("protocol") or {}
+    return {**study, "method": learner.get("method"), "rounds": protocol.get("budget"),
+            "intention": study.get("intention_name")}
+
+
 def session_record(folder: Path) -> dict:
     """One session folder as one record (ValueError when it is not a session's folder)."""
     info = _read_json(folder / "session.json")
     if not isinstance(info, dict) or not isinstance(info.get("study"), dict):
         raise ValueError("no readable session.json")
-    study = info["study"]
+    study = study_fields(info["study"])
     design = info.get("design") or study.get("design") or "unknown"
     summary = _read_json(folder / "summary.json")
     summary = summary if isinstance(summary, dict) else {}

@@ -41,6 +41,7 @@ from activeintent.web.session import (
     new_session_key,
     signal_page,
 )
+from activeintent.web.session_view import session_state
 from activeintent.web.study import PID_RULE, URL_PARAMETERS, StudyFile, check_pid
 from activeintent.web.transport import ConnectionGuard, RequestPhases
 
@@ -302,7 +303,7 @@ def config_view(config: StudyConfig, study: StudyFile | None, manager: SessionMa
     if study is not None:
         # conditions differ per participant and are not for participants to read
         return {"study": True, "consent": study.consent, "require_pid": study.require_pid,
-                "rounds": next(iter(manager.conditions.values()))[0].rounds,
+                "rounds": next(iter(manager.conditions.values()))[0].budget,
                 "url_parameters": list(URL_PARAMETERS)}
     assigned = config.design == "assigned-rule"
     return {
@@ -310,13 +311,13 @@ def config_view(config: StudyConfig, study: StudyFile | None, manager: SessionMa
         "consent": None,
         "require_pid": False,
         "url_parameters": list(URL_PARAMETERS),
-        "method": config.method,
+        "method": config.run.learner.method,
         "signal": config.signal,
-        "rounds": config.rounds,
+        "rounds": config.budget,
         # assigned-rule: the rule participants are given (and are scored against);
         # free-rule: every participant picks their own, nothing is scored
         "design": config.design,
-        "intention": config.intention if assigned else None,
+        "intention": config.intention_name,
         "intention_description": config.intention_description if assigned else None,
         "show_estimate": config.show_estimate,
         "fps": config.fps,
@@ -344,11 +345,11 @@ def add_session_routes(app: FastAPI, manager: SessionManager, guard: SessionLimi
                                consent=body.consent, key_sha256=key_sha256)
         response.set_cookie(KEY_COOKIE, key, max_age=KEY_COOKIE_MAX_AGE, path=f"/api/sessions/{session.id}",
                             httponly=True, samesite="strict", secure=request.url.scheme == "https")
-        return session.state()
+        return session_state(session)
 
     @app.get("/api/sessions/{sid}", summary="Session state: round i of K, the question, z, status")
     def get_session(sid: str) -> dict:
-        return session_or_404(sid).state()
+        return session_state(session_or_404(sid))
 
     def post_answer(session: Owned, request: Request, body: WebForm) -> dict:
         client = {name: getattr(body, name) for name in body.logged}
@@ -444,28 +445,21 @@ def _file(path: Path):
     return serve_file
 
 
-def runner_builder(config: StudyConfig, **options: Any) -> EpisodeBuilder:
-    """Sessions built by :func:`activeintent.runner.build_episode` (method, assigned rule,
-    rounds from the study; ``options`` are further RunOptions fields, e.g. llm). A free-rule
-    study gives no intention: the runner's default stands in for the simulated parts and is
-    neither shown nor scored (see :func:`activeintent.web.session.study_summary`)."""
+def runner_builder(config: StudyConfig) -> EpisodeBuilder:
+    """Sessions built by :func:`activeintent.runner.build_episode` from the study's run spec. A
+    free-rule study gives no intention: the runner's default stands in for the simulated parts
+    and is neither shown nor scored (see :func:`activeintent.web.session.study_summary`)."""
     # People watch physics; the session exports its own videos; the learner is scored on the
     # test scenes after the last answer only (no one waits for a curve).
-    base = {"method": config.method, "budget": config.rounds, "env": config.env, "video": "none",
-            "curve": False, **options}
-    if config.intention_file is not None:
-        base["intention_file"] = config.intention_file
-    elif config.intention is not None:
-        base["intention"] = config.intention
+    run = config.run.with_options(video="none", curve=False)
     # The final attempt is what participants judge: with an assigned rule, on a table where
     # that rule can be shown at all; a free rule is unknown, so on the first table the learner's
     # own belief expects to be able to show its goals on.
     show = "first-feasible" if config.design == "assigned-rule" else "learner-showable"
 
     def build(seed: int, out_dir: Path, user, observers):
-        from activeintent.runner import RunOptions, build_episode
+        from activeintent.runner import build_episode
 
-        return build_episode(RunOptions(**base, seed=seed), out_dir, user=user, observers=observers,
-                             show_final=show)
+        return build_episode(run.with_options(seed=seed), out_dir, user=user, observers=observers, show_final=show)
 
     return build

@@ -38,10 +38,12 @@ from pydantic import BaseModel, Field, computed_field, field_validator, model_va
 from activeintent.protocol import FORMAT_VERSION
 from activeintent.records import EpisodeRecorder, dumps
 from activeintent.signals import AnswerRejected, ShownRound
+from activeintent.spec import RunSpec
 from activeintent.users.human import HumanUser, Question, SessionCancelled
 from activeintent.web.basics import VIDEO_SIZE, EstimateMode, parse_video_size, write_json
 from activeintent.web.errors import ApiError
 from activeintent.web.live import LiveExport
+from activeintent.web.questionnaire import Questionnaire
 from activeintent.web.videos import SessionVideos, VideoInfo
 
 SESSION_ID = re.compile(r"^[0-9a-f]{16}$")
@@ -63,23 +65,22 @@ Design = Literal["assigned-rule", "free-rule"]
 
 
 class StudyConfig(BaseModel):
-    """What every session of one `activeintent serve` runs; participants cannot change it."""
+    """What every session of one `activeintent serve` runs; participants cannot change it.
 
-    method: str
+    ``run`` is the episode each session runs (method, K, env, the assigned rule in its user
+    section, models); session n runs with its seed + n unless it asks for one. The rest is the
+    study's own: the signal's page, what participants read and see, and the server's limits."""
+
+    run: RunSpec
     signal: str = Field(description="the signal plug-in the study asks for (see activeintent.signals)")
-    rounds: int = Field(ge=1, le=100, description="K: signals asked of each participant")
-    intention: str | None = Field(
-        None, description="the rule every participant is assigned (and success is scored against); "
-        "None: each participant picks their own rule and success is not scored")
-    intention_file: str | None = Field(None, description="the assigned rule from a file (path.py:NAME)")
+    intention_name: str | None = Field(
+        None, description="the assigned rule's name (filled from run.user); None: each participant picks their "
+        "own rule and success is not scored")
     intention_description: str | None = Field(None, description="the assigned rule in words, as participants read it")
     show_estimate: EstimateMode = Field(
         "hidden", description="the learner's current guess z: never shown (hidden), shown between rounds "
         "after each answer (after-answer), or above the videos from round 2 on (always)")
-    env: str = Field("pybullet", description="the env the robot's work runs and is filmed in (people watch "
-                     "physics; it must render)")
     out_dir: Path = Path("out/web")
-    seed: int = Field(0, description="session n (0, 1, …) runs with seed + n unless it asks for one")
     fps: int = Field(10, ge=1, le=60, description="frames per second of the videos")
     video_size: tuple[int, int] = Field(VIDEO_SIZE, description="width, height of the videos in pixels (at the "
                                         "default every block is at least 40 px wide)")
@@ -92,30 +93,40 @@ class StudyConfig(BaseModel):
     @property
     def design(self) -> Design:
         """assigned-rule when the study gives participants a rule, else free-rule."""
-        return "assigned-rule" if self.intention or self.intention_file else "free-rule"
+        return "assigned-rule" if self.run.user.intention or self.run.user.intention_file else "free-rule"
+
+    @property
+    def budget(self) -> int:
+        """K: the signals asked of each participant."""
+        return self.run.protocol.budget
 
     @field_validator("video_size")
     @classmethod
     def _video_size_in_range(cls, size: tuple[int, int]) -> tuple[int, int]:
         return parse_video_size(f"{size[0]}x{size[1]}")  # the CLI's rule: 64-2048 pixels a side
 
-    @field_validator("env")
+    @field_validator("run")
     @classmethod
-    def _known_env(cls, v: str) -> str:
+    def _people_watch_physics(cls, run: RunSpec) -> RunSpec:
         from activeintent.envs import ENVS
 
-        return ENVS.check(v)
+        ENVS.check(run.env.name)
+        if run.protocol.budget < 1:
+            raise ValueError("a study asks each participant for at least one signal (budget ≥ 1)")
+        return run
 
     @model_validator(mode="after")
     def _describe_rule(self) -> StudyConfig:
-        if self.design == "assigned-rule" and self.intention_description is None:
+        if self.design == "assigned-rule" and (self.intention_name is None or self.intention_description is None):
             from activeintent.suites import resolve
 
-            rule = resolve(None if self.intention_file else self.intention, self.intention_file)
-            self.intention = rule.name
-            self.intention_description = rule.description or rule.name
+            who = self.run.user
+            rule = resolve(None if who.intention_file else who.intention, who.intention_file)
+            self.intention_name = rule.name
+            if self.intention_description is None:
+                self.intention_description = rule.description or rule.name
         if self.design == "free-rule":
-            self.intention_description = None
+            self.intention_name = self.intention_description = None
         return self
 
 
@@ -288,10 +299,9 @@ class WebSession:
         self.guess: Guess | None = None  # the same, with its confidence
         self.final_guess: Guess | None = None
         self.final_scene: list[str] | None = None
-        self.questionnaire: dict | None = None
+        self.questionnaire = Questionnaire(self.dir, sid)
         self.ended: float | None = None
         self._belief_top: Any = None  # the last belief snapshot of a Bayesian learner
-        self._questionnaire_lock = threading.Lock()
         self.phase: Literal["rounds", "final"] = "rounds"
         self.rounds: list[RoundInfo] = []
         self.result: dict | None = None
@@ -401,7 +411,7 @@ class WebSession:
             scene=list(q.scene.objects),
             estimate=self.estimate,
             confidence=self.guess.confidence if self.guess else None,
-            estimate_shown=self._guess_visible(self.guess),  # how: the study's show_estimate
+            estimate_shown=self.guess_visible(self.guess),  # how: the study's show_estimate
             videos=[v.model_dump() for v in videos],
         )
         return videos
@@ -417,7 +427,7 @@ class WebSession:
             if isinstance(call, dict) and "top" in call:  # a Bayesian learner's belief after the answer
                 self._belief_top = call["top"]
                 break
-        if log.signals_used >= self.config.rounds:
+        if log.signals_used >= self.config.budget:
             self.phase = "final"
 
     def tested(self, k: int, index: int, scene: Any, estimate: Any, traj: Any) -> None:
@@ -502,97 +512,21 @@ class WebSession:
         self.log_server(f"video_{event}", round=round, media_time=media_time, replays=out["replays"])
         return out
 
-    def _guess_visible(self, guess: Guess | None) -> bool:
+    def guess_visible(self, guess: Guess | None) -> bool:
         # never the learner's prior: a guess is shown only once it rests on an answer
         return self.config.show_estimate != "hidden" and guess is not None and guess.answers >= 1
 
-    def visible_guess(self) -> Guess | None:
-        """The guess the participant may see now: the current question's (while it waits for
-        an answer) or the final one (once finished); None when the study hides it."""
-        status = self.status
-        guess = self.guess if status == "waiting-for-answer" else self.final_guess if status == "finished" else None
-        return guess if self._guess_visible(guess) else None
+    @property
+    def asks_final_attempt(self) -> bool:
+        """Whether the questionnaire asks about the robot's final attempt (it was shown)."""
+        return self.final_video is not None and self.status == "finished"
 
-    def state(self) -> dict:
-        q = self.user.question
-        status = self.status
-        question = None
-        if q is not None and status == "waiting-for-answer":
-            objects = list(q.scene.objects)
-            question = {
-                "round": q.round,
-                "kind": self.config.signal,
-                "scene": objects,
-                "legend": scene_legend(objects),
-                # complete: the whole file is written (before that it is sent as it grows)
-                "videos": [{**v.model_dump(), "complete": self.live_export(v.file) is None} for v in (q.presented or [])],
-                "viewing": self.viewing(q.round),
-            }
-        guess = self.visible_guess()
-        finished = status == "finished"
-        return {
-            "id": self.id,
-            "method": self.config.method,
-            "signal": self.config.signal,
-            "page": signal_page(self.config.signal),
-            "design": self.config.design,
-            "intention": self.config.intention if self.config.design == "assigned-rule" else None,
-            "intention_description": self.config.intention_description,
-            "show_estimate": self.config.show_estimate,
-            "status": status,
-            "phase": self.phase,
-            "rounds": self.config.rounds,
-            "rounds_answered": len(self.rounds),
-            "signals_used": self.signals_used,
-            # the round the participant is on, as "round i of K"
-            "progress": min(self.signals_used + 1, self.config.rounds),
-            "question": question,
-            "button_order": self.enrolment.button_order,
-            "estimate": guess.model_dump() if guess else None,
-            # the completion code and redirect: once the questionnaire is in
-            "completion": self.completion.model_dump() if self.completion and self.questionnaire else None,
-            "final_video": self.final_video.model_dump() if self.final_video and finished else None,
-            "final_legend": scene_legend(self.final_scene) if self.final_scene and finished else None,
-            "success": self.result.get("success") if self.result else None,
-            "success_basis": self.result.get("success_basis") if self.result else None,
-            "questionnaire": {
-                "open": not self.active and self.questionnaire is None,
-                "submitted": self.questionnaire is not None,
-                "asks_final_attempt": self.final_video is not None and finished,
-            },
-            "error": self.error,
-        }
-
-    # -- the end-of-session questionnaire (request threads) ------------------------------------
     def submit_questionnaire(self, answers: dict, by: dict | None = None) -> dict:
         """Keep the participant's answers in ``questionnaire.json`` (once; after the episode)."""
-        if self.active:
-            raise ApiError(409, "conflict", f"session {self.id} is {self.status}: the questionnaire comes "
-                           "after the robot's final attempt")
-        asks = self.final_video is not None and self.status == "finished"
-        if asks and answers.get("final_attempt") is None:
-            raise ApiError(422, "invalid_answer", "final_attempt is required: did the final attempt do what "
-                           "you wanted? 'yes', 'partly' or 'no'")
-        if not asks and answers.get("final_attempt") is not None:
-            raise ApiError(422, "invalid_answer", f"session {self.id} ended without a final attempt "
-                           f"({self.status}); leave final_attempt out")
-        with self._questionnaire_lock:
-            if self.questionnaire is not None or (self.dir / "questionnaire.json").exists():
-                raise ApiError(409, "already_submitted", f"the questionnaire of session {self.id} is already "
-                               "answered; the answers are kept as they were")
-            record = {
-                "session": self.id,
-                "participant": self.participant,
-                "condition": self.enrolment.condition,
-                "design": self.config.design,
-                "intention": self.config.intention if self.config.design == "assigned-rule" else None,
-                "session_status": self.status,
-                "submitted": time.time(),
-                **answers,
-                "answered_by": by,
-            }
-            write_json(self.dir / "questionnaire.json", record)
-            self.questionnaire = record
+        about = {"session": self.id, "participant": self.participant, "condition": self.enrolment.condition,
+                 "design": self.config.design, "intention": self.config.intention_name}
+        record = self.questionnaire.submit(answers, status=self.status, active=self.active,
+                                           asks_final_attempt=self.asks_final_attempt, about=about, by=by)
         self.log_server("questionnaire_submitted", final_attempt=answers.get("final_attempt"),
                         rule_chars=len(answers.get("rule") or ""), comments_chars=len(answers.get("comments") or ""))
         return record
@@ -663,7 +597,7 @@ class SessionManager:
             got = self.assigner.assign(pid)
             config, builder = self.conditions[got.condition]
             if seed is None:
-                seed = config.seed + got.number  # persisted: a restarted server does not repeat seeds
+                seed = config.run.protocol.seed + got.number  # persisted: a restarted server does not repeat seeds
             sid = secrets.token_hex(8)
             while sid in self._sessions or (self.config.out_dir / sid).exists():
                 sid = secrets.token_hex(8)

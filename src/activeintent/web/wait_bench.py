@@ -44,12 +44,13 @@ def measure_waits(method: str, rounds: int, video_size: tuple[int, int], seed: i
     from fastapi.testclient import TestClient
 
     from activeintent.learners.registry import get_method
+    from activeintent.spec import RunSpec
     from activeintent.web.server import create_app, runner_builder
     from activeintent.web.session import StudyConfig
 
-    config = StudyConfig(method=method, signal=get_method(method).signal, rounds=rounds, out_dir=out,
-                         intention=intention, video_size=video_size)
-    app = create_app(config, runner_builder(config, llm="none"))
+    run = RunSpec.from_options(method=method, budget=rounds, intention=intention, llm="none")
+    config = StudyConfig(run=run, signal=get_method(method).signal, out_dir=out, video_size=video_size)
+    app = create_app(config, runner_builder(config))
     waits: list[float] = []
     ahead: list[float] = []  # per video: its length minus the seconds until it was complete
     with TestClient(app) as client:

@@ -76,13 +76,13 @@ def register(app: typer.Typer) -> None:
         """Learner time per signal of bayes-preference and bayes-stop (target ≤ 2 s median),
         measured in the one episode loop (symbolic env, human-preset users, no model)."""
         from activeintent.intentions.registry import PAPER_INTENTIONS
-        from activeintent.runner import RunOptions, build_episode
+        from activeintent.runner import RunSpec, build_episode
 
         result: dict = {}
         for method in ("bayes-preference", "bayes-stop"):
             per_signal = []
             for t in range(trials):
-                options = RunOptions(method=method, intention=PAPER_INTENTIONS[t % 4], seed=seed + t,
+                options = RunSpec.from_options(method=method, intention=PAPER_INTENTIONS[t % 4], seed=seed + t,
                                      env="symbolic", llm="none", video="none", curve=False)
                 keep = _Keep()
                 build_episode(options, observers=[keep]).run()

@@ -226,7 +226,7 @@ def lang_method(signal: str, prefix: str = "lang"):
 
     def build(ctx: LearnerContext) -> LangLearner:
         learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm,
-                              config=LangConfig(prior=ctx.prior, **settings))  # type: ignore[arg-type]
+                              config=LangConfig(prior=ctx.config.prior, **settings))  # type: ignore[arg-type]
         learner.name = f"{prefix}-{signal}"
         return learner
 
