@@ -21,6 +21,7 @@ from typer.testing import CliRunner
 from activeintent.cli import app
 from activeintent.records import read_rounds
 from activeintent.sim.env import SimConfig
+from activeintent.web.session_view import session_state
 
 DOCS_IMG = Path(__file__).resolve().parents[2] / "docs" / "img"
 UPDATING = os.environ.get("ACTIVEINTENT_UPDATE_SCREENSHOTS") == "1"
@@ -153,7 +154,7 @@ def test_clicker_session_stops_at_a_known_moment(live_server, page, tmp_path):
     wait_videos(page, "video")
     ready(page)
     assert not page.evaluate("document.getElementById('video').loop")  # plays once
-    video = srv.manager.get(sid).state()["question"]["videos"][0]
+    video = session_state(srv.manager.get(sid))["question"]["videos"][0]
     fps = video["fps"]
     # the moment to stop: the middle of a frame about 40% into the video
     k = int(0.4 * (video["frames"] - 1))
@@ -178,7 +179,7 @@ def test_clicker_session_stops_at_a_known_moment(live_server, page, tmp_path):
     wait_videos(page, "video")
     ready(page)
     assert page.is_disabled("#good")  # not before the video has ended
-    near_end(page, srv.manager.get(sid).state()["question"]["videos"][0]["duration"], 0.3)
+    near_end(page, session_state(srv.manager.get(sid))["question"]["videos"][0]["duration"], 0.3)
     page.wait_for_selector("#good:enabled")
     page.click("#good")
 
@@ -240,7 +241,7 @@ def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server,
         assert page.get_by_role("button", name=name, exact=True).count() == 1, name
     assert page.evaluate("[...document.querySelectorAll('button kbd')].every(k => k.getAttribute('aria-hidden') === 'true')")
     assert page.get_attribute("#video-a", "aria-label").startswith("Video A")
-    scene = free.manager.get(sid).state()["question"]["scene"]
+    scene = session_state(free.manager.get(sid))["question"]["scene"]
     assert all(name in page.text_content("#caption-a") for name in scene)
     assert not page.is_visible("#estimate")
     assert not page.is_visible("#legend")
@@ -378,7 +379,7 @@ def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
     assert page.evaluate("new Set([...document.querySelectorAll('#answers button')].map(b => b.className)).size") == 1
     page.keyboard.press("Enter")  # Ready
     page.wait_for_selector('#question[data-phase="first"]')
-    video = session.state()["question"]["videos"][0]
+    video = session_state(session)["question"]["videos"][0]
     near_end(page, video["duration"], 0.05)
     page.wait_for_selector('#question[data-phase="ended"]')
     assert page.is_disabled("#stop") and page.is_enabled("#good")
@@ -418,7 +419,7 @@ def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
     wait_round(page, 2)
     wait_videos(page, "video")
     ready(page)
-    near_end(page, session.state()["question"]["videos"][0]["duration"], 0.05)
+    near_end(page, session_state(session)["question"]["videos"][0]["duration"], 0.05)
     page.wait_for_selector("#good:enabled")
     page.click("#good")
 
