@@ -28,9 +28,9 @@ SUBSET = tuple(FEATURE_NAMES.index(n) for n in (
     "all:part-of-row", "all:region[middle]"))
 
 
-def small_learner(seed: int = 0) -> RewardLearner:
+def small_learner(seed: int = 0, prior: str = "uniform") -> RewardLearner:
     return RewardLearner("preference", rng=seed, config=RewardConfig(
-        planner=False, n_scenes=1, features=SUBSET, particles=512))
+        planner=False, n_scenes=1, features=SUBSET, particles=512, prior=prior))
 
 
 def exact_answer(w_true: np.ndarray, trajectories) -> str:
@@ -66,6 +66,17 @@ def test_the_posterior_mean_direction_converges_on_a_linear_intention(seed):
     for k in range(20):
         ask(learner, rng, k, lambda t: exact_answer(w_true, t))
     assert cosine(learner.belief.direction(), w_true) >= 0.9
+
+
+@pytest.mark.parametrize("prior", ["uniform", "heavy-tailed"])
+def test_either_prior_converges_on_a_reward_of_two_features(prior):
+    w_true = np.zeros(len(SUBSET))
+    w_true[[0, 3]] = (0.8, -0.6)  # blocks in bowls, not beside blocks
+    learner, rng = small_learner(3, prior), np.random.default_rng(103)
+    for k in range(20):
+        ask(learner, rng, k, lambda t: exact_answer(w_true, t))
+    assert cosine(learner.belief.direction(), w_true) >= 0.9
+    assert learner.belief.accept[-1] > 0  # the moves move
 
 
 def test_a_wrong_answer_does_not_collapse_the_belief():

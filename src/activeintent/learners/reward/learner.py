@@ -53,6 +53,8 @@ class RewardConfig(BaseModel):
     moves: int = Field(24, ge=0, description="Metropolis–Hastings moves after each answer")
     final_depth: int = Field(4, ge=0, description="steps of greedy ascent on E[w]·φ for the final answer")
     features: tuple[int, ...] | None = Field(None, description="indices of FEATURE_NAMES to use (None: all)")
+    prior: str = Field("uniform", description="prior over w: uniform on the sphere (APReL's) | heavy-tailed "
+                       "(few heavily weighted features as likely as many light ones; examples/reward_prior.py)")
     model: RewardModel = Field(default_factory=RewardModel)
 
 
@@ -73,7 +75,7 @@ class RewardLearner(Learner):
             raise ValueError(f"reward learners read preference or stop; got {signal!r}")
         self.signal = signal
         self.config = c = config or RewardConfig()
-        self.name = f"reward-{signal}" + ("" if c.planner else "-noplanner")
+        self.name = f"reward-{signal}" + ("" if c.planner else "-noplanner") + ("" if c.prior == "uniform" else f"-{c.prior}")
         self.rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng or 0)
         self.idx = np.arange(len(FEATURE_NAMES)) if c.features is None else np.array(c.features, int)
         self.names = [FEATURE_NAMES[i] for i in self.idx]
@@ -82,7 +84,7 @@ class RewardLearner(Learner):
         # comparison threshold are on the reward scale and the reward learner's own (config.model).
         self.model = get_signal(signal).learner_model()
         self.reward_model = assumed(c.model, self.model)
-        self.belief = RewardBelief(len(self.idx), self.rng, self.reward_model, c.particles, c.moves)
+        self.belief = RewardBelief(len(self.idx), self.rng, self.reward_model, c.particles, c.moves, c.prior)
         # Final answers are scored on the same test scenes at every k: what does not depend on
         # the answers (the planner's plans on its prior, successors' φ) is computed once per
         # scene, from a generator of its own (the scene's exact layout and one seed drawn here).
