@@ -10,9 +10,10 @@ Prior ``heavy-tailed``: w = x / ‖x‖ with x_i independent standard Cauchy —
 weighs a few features heavily is a priori as likely as one that weighs all a little (the
 principle: few features, short description). The particles keep x; a move is a symmetric
 random walk x' = x + s · m · ε (m: the median |x| over every particle and feature, fixed for the
-move) accepted with the prior ratio ∏ (1 + x_i²) / (1 + x_i'²) times the likelihood ratio. Every draw comes from the learner's generator;
-log-likelihood differences are quantised before the accept test (``ranking``) so that float
-noise cannot flip a choice.
+move) accepted with the prior ratio ∏ (1 + x_i²) / (1 + x_i'²) times the likelihood ratio.
+
+Every draw comes from the learner's generator; log-likelihood differences are quantised before
+the accept test (``ranking``) so that float noise cannot flip a choice.
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ class RewardBelief:
                  prior: str = "uniform"):
         if prior not in PRIORS:
             raise ValueError(f"unknown reward prior {prior!r}; valid priors: {', '.join(PRIORS)}")
-        self.d, self.rng, self.model, self.moves, self.prior = d, rng, model, moves, prior
+        self.d, self.rng, self.model, self.moves = d, rng, model, moves
         self.X = rng.standard_cauchy((n, d)) if prior == "heavy-tailed" else None
         self.W = _normalise(rng.standard_normal((n, d)) if self.X is None else self.X)
         self.log_w = np.zeros(n)
