@@ -320,18 +320,27 @@ class BayesLearner(Learner):
     def final(self, scene: Scene, state: WorldState) -> Estimate:
         """The plan with the largest expected success Σ_z w_z 1[z satisfied by its outcome],
         among the plans of the hypotheses that can be shown in this scene."""
-        feasible = self.judge.feasible(scene.objects)
-        w = self.weights * feasible
-        w = w / w.sum() if w.sum() > 0 else self.weights
+        w, feasible = self.scene_weights(scene)
         outs = self._final_outcomes(state, w, feasible)
-        finals = [facts(o.traj.outcome) for o in outs]
-        self.judge.prefetch(finals)
-        success = np.array([float(w @ self.judge.judge(f)[0]) for f in finals])
+        success = self.expected_success(w, outs)
         best = ranking.argmax(success - 1e-6 * np.array([len(o.plan) for o in outs]))
         top = self.hyps[ranking.argmax(w, ranking.WEIGHT_DECIMALS)]
         plan = outs[best].plan
         return Estimate(z=top.description, goals=[describe_plan(plan)], plans=[plan], done=True,
                         why={"expected_success": round(float(success[best]), 4)})
+
+    def scene_weights(self, scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+        """w_z given that z can be shown in this scene (the belief itself when none can), and
+        the feasibility mask."""
+        feasible = self.judge.feasible(scene.objects)
+        w = self.weights * feasible
+        return (w / w.sum() if w.sum() > 0 else self.weights), feasible
+
+    def expected_success(self, w: np.ndarray, outs: list) -> np.ndarray:
+        """Σ_z w_z 1[z holds after the plan], per predicted outcome."""
+        finals = [facts(o.traj.outcome) for o in outs]
+        self.judge.prefetch(finals)
+        return np.array([float(w @ self.judge.judge(f)[0]) for f in finals])
 
     def _final_outcomes(self, state: WorldState, w: np.ndarray, feasible: np.ndarray) -> list:
         """What the final answer chooses among: doing nothing and the likely z's plans."""

@@ -18,6 +18,8 @@ the accept test (``ranking``) so that float noise cannot flip a choice.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from activeintent import ranking
@@ -40,6 +42,7 @@ class RewardBelief:
         self.X = rng.standard_cauchy((n, d)) if prior == "heavy-tailed" else None
         self.W = _normalise(rng.standard_normal((n, d)) if self.X is None else self.X)
         self.log_w = np.zeros(n)
+        self.log_evidence = 0.0  # log Π_k P(h_k | h_<k): the marginal likelihood, estimated by the particles
         self.obs: list[RewardObservation] = []
         self.accept: list[float] = []
 
@@ -71,6 +74,7 @@ class RewardBelief:
         """Bayes' rule on the particles; returns the evidence P(h) under the belief before."""
         lik = obs.log_lik(self.W, self.model)
         evidence = float(self.weights @ np.exp(lik))
+        self.log_evidence += math.log(max(evidence, 1e-300))
         self.obs.append(obs)
         self.log_w = self.log_w + lik
         self.log_w -= self.log_w.max()
@@ -90,6 +94,8 @@ class RewardBelief:
         self.log_w = np.zeros(n)
 
     def _move(self) -> None:
+        if not self.moves:  # no moves, no acceptance rate
+            return
         if self.X is not None:
             self._move_heavy_tailed()
             return

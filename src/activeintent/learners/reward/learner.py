@@ -239,18 +239,30 @@ class RewardLearner(Learner):
     def final(self, scene: Scene, state: WorldState) -> Estimate:
         """The candidate plan whose predicted outcome has the largest E[w] · φ (doing nothing
         included); candidates: the planner's (if on), greedy ascent on E[w] · φ."""
-        c = self.config
         mean = self.belief.mean()
+        outs = self.final_outcomes(state)
+        values = np.array([mean @ self.phi(o.traj.outcome) for o in outs])
+        best = ranking.argmax(values - 1e-6 * np.array([len(o.plan) for o in outs]))
+        plan = outs[best].plan
+        return Estimate(z=self.describe(), goals=[describe_plan(plan)], plans=[plan], done=True,
+                        why={"expected_reward": round(float(values[best]), 4), "candidates": len(outs)})
+
+    def final_outcomes(self, state: WorldState) -> list[Outcome]:
+        """What the final answer chooses among: doing nothing, the planner's plans (if on) and
+        every prefix of a greedy ascent on E[w] · φ."""
         pool = cand.Pool(state, keep_nothing=True)
         pool.extend(self._final_base(state))
         w_full = np.zeros(len(FEATURE_NAMES))
-        w_full[self.idx] = mean
-        cand.reward_plans(pool, w_full, depth=c.final_depth, memo=self._final_phi)
-        values = np.array([mean @ self.phi(o.traj.outcome) for o in pool.outs])
-        best = ranking.argmax(values - 1e-6 * np.array([len(o.plan) for o in pool.outs]))
-        plan = pool.outs[best].plan
-        return Estimate(z=self.describe(), goals=[describe_plan(plan)], plans=[plan], done=True,
-                        why={"expected_reward": round(float(values[best]), 4), "candidates": len(pool.outs)})
+        w_full[self.idx] = self.belief.mean()
+        cand.reward_plans(pool, w_full, depth=self.config.final_depth, memo=self._final_phi)
+        return pool.outs
+
+    def p_best(self, outs: list[Outcome]) -> np.ndarray:
+        """P(the outcome has the largest reward w · φ among ``outs``) under the belief, per
+        outcome (outcomes of equal reward share a particle's mass in full: each is a best)."""
+        R = self.belief.W @ np.array([self.phi(o.traj.outcome) for o in outs]).T  # [M, C]
+        best = ranking.quantised(R) >= ranking.quantised(R.max(axis=1, keepdims=True))
+        return self.belief.weights @ best
 
     def _final_base(self, state: WorldState) -> list[Outcome]:
         """Doing nothing and (if on) the planner's plans on its prior, once per exact layout."""
