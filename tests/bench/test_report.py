@@ -176,3 +176,13 @@ def test_unscored_episodes_count_in_signals_answers_and_excluded_scenes(tmp_path
     row = next(line for line in text.splitlines() if line.startswith("| bayes-stop |"))
     cells = [c.strip() for c in row.strip("|").split("|")]
     assert cells[3:6] == ["2.0", "2/4", "2.0"] and cells[-1] == "1"
+
+
+def test_a_hybrid_is_paired_with_the_language_learner_it_extends(tmp_path):
+    methods = ["lang-stop", "hybrid-stop", "hybrid-stop-map", "zero-signal"]
+    records = records_of(methods)
+    text = write_report(records, methods, ["stack", "align"], tmp_path, SETTINGS).read_text()
+    section = text.split("## Paired comparisons")[1]
+    assert "decide and hybrid against lang" in section
+    rows = [line.split(" | ")[0] for line in section.splitlines() if line.startswith("| ") and " − " in line]
+    assert "| hybrid-stop − lang-stop" in rows and "| hybrid-stop-map − lang-stop" in rows

@@ -98,9 +98,11 @@ def wilson(successes: float, n: int, z: float = 1.96) -> tuple[float, float]:
 
 
 # EIG learners and the baselines that share their belief but ask at random; the decision-aware
-# learners and the language learners they extend.
+# learners and the hybrids (examples/hybrid.py) against the language learners they extend.
 PAIRED = (("bayes-stop", "random-query"), ("bayes-preference", "random-query-preference"),
-          ("decide-stop", "lang-stop"), ("decide-preference", "lang-preference"))
+          ("decide-stop", "lang-stop"), ("decide-preference", "lang-preference"),
+          ("hybrid-stop", "lang-stop"), ("hybrid-preference", "lang-preference"),
+          ("hybrid-stop-map", "lang-stop"), ("hybrid-preference-map", "lang-preference"))
 
 
 def auc(curve: list[float | None]) -> float | None:
@@ -193,7 +195,7 @@ def best_baseline(records: list[dict], methods: list[str]) -> str | None:
 
 
 def paired_section(records: list[dict], methods: list[str]) -> list[str]:
-    """The fixed pairs (EIG against random questions, decide against lang) and every other
+    """The fixed pairs (EIG against random questions, decide and hybrid against lang) and every other
     method against the best baseline, on the same trials."""
     best = best_baseline(records, methods)
     pairs = [(a, b) for a, b in PAIRED if a in methods and b in methods]
@@ -205,10 +207,11 @@ def paired_section(records: list[dict], methods: list[str]) -> list[str]:
     if not rows:
         return []
     against = f" and every method against the best baseline here, **{best}** (highest mean success@K)" if best else ""
+    extends = "decide and hybrid" if any(a.startswith("hybrid-") for a, _ in pairs) else "decide"
     peer_text = (", every learner against the reward-learning peer of its signal "
                  f"({', '.join(sorted({b for _, b in peers}))})") if peers else ""
     lines = ["", "## Paired comparisons", "",
-             f"EIG against random questions, decide against lang{peer_text}{against}. Each episode of the method is paired "
+             f"EIG against random questions, {extends} against lang{peer_text}{against}. Each episode of the method is paired "
              "with the other method's episode on the same intention and trial (same query-scene seeds, user noise "
              "and test scenes); n = pairs. Area: the mean of the episode's success@k over k = 0..K, difference "
              "with a 95 % interval from the normal approximation of the paired mean; wins / ties / losses and "
