@@ -60,6 +60,11 @@ class HybridLearner(Learner):
         self.stop_log_density = 0.0  # Σ_k log density of the press times (stops only), see above
         self.answer_log: list[dict] = []
 
+    @property
+    def model(self):
+        """What both classes assume of people: the signal's learner model (never a user's)."""
+        return self.lang.model
+
     # ---- the classes' posterior ----
 
     def log_evidence(self) -> tuple[float, float]:
