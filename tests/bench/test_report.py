@@ -144,13 +144,17 @@ def test_every_method_is_paired_against_the_best_baseline(tmp_path):
     assert all(m not in BASELINES for m in ("bayes-stop", "lang-stop"))
 
 
-def test_every_learner_is_paired_with_the_reward_peer_of_its_signal(tmp_path):
-    methods = ["bayes-stop", "lang-stop", "reward-stop", "reward-stop-noplanner", "zero-signal"]
-    records = records_of(methods)
-    text = write_report(records, methods, ["stack", "align"], tmp_path, SETTINGS).read_text()
+def paired_rows(methods: list[str], tmp_path) -> tuple[str, list[str]]:
+    """The report's paired section for synthetic episodes of ``methods``, and its row names."""
+    text = write_report(records_of(methods), methods, ["stack", "align"], tmp_path, SETTINGS).read_text()
     section = text.split("## Paired comparisons")[1]
+    return section, [line.split(" | ")[0] for line in section.splitlines() if line.startswith("| ") and " − " in line]
+
+
+def test_every_learner_is_paired_with_the_reward_peer_of_its_signal(tmp_path):
+    section, rows = paired_rows(["bayes-stop", "lang-stop", "reward-stop", "reward-stop-noplanner", "zero-signal"],
+                                tmp_path)
     assert "reward-learning peer of its signal (reward-stop)" in section
-    rows = [line.split(" | ")[0] for line in section.splitlines() if line.startswith("| ") and " − " in line]
     assert "| bayes-stop − reward-stop" in rows and "| lang-stop − reward-stop" in rows
     assert not [r for r in rows if r.startswith("| reward-stop") and "zero-signal" not in r]  # not with itself
     assert report.peer_pairs(["bayes-preference", "reward-stop"]) == []  # only the peer of the same signal
@@ -179,10 +183,6 @@ def test_unscored_episodes_count_in_signals_answers_and_excluded_scenes(tmp_path
 
 
 def test_a_hybrid_is_paired_with_the_language_learner_it_extends(tmp_path):
-    methods = ["lang-stop", "hybrid-stop", "hybrid-stop-map", "zero-signal"]
-    records = records_of(methods)
-    text = write_report(records, methods, ["stack", "align"], tmp_path, SETTINGS).read_text()
-    section = text.split("## Paired comparisons")[1]
+    section, rows = paired_rows(["lang-stop", "hybrid-stop", "hybrid-stop-map", "zero-signal"], tmp_path)
     assert "decide and hybrid against lang" in section
-    rows = [line.split(" | ")[0] for line in section.splitlines() if line.startswith("| ") and " − " in line]
     assert "| hybrid-stop − lang-stop" in rows and "| hybrid-stop-map − lang-stop" in rows
