@@ -15,6 +15,8 @@
   requirement drawn from the needs belief;
 - ``decide-chains-stop`` (a variant): stop queries may also show one likely goal's plan followed by
   another's (``BayesConfig.chains = 4``);
+- ``decide-split-stop`` (a variant): stop queries may also show plans grown step by step, each
+  step moving away from about half of the likely goals left (``BayesConfig.split = 3``);
 - ``decide-joint-<signal>`` (a variant): the final answer may also run a plan for both goals of a
   pair of the 4 likeliest goals (``LangConfig.final_joint = 4``).
 """
@@ -31,8 +33,9 @@ ABLATIONS = {
     "needs-scenes": {"scenes": "needs"},
     "chains": {"chains": 4},
     "joint": {"final_joint": 4},
+    "split": {"split": 3},
 }
-VARIANTS = ("needs-scenes", "chains", "joint")
+VARIANTS = ("needs-scenes", "chains", "joint", "split")
 
 
 def _ablation(part: str, signal: str) -> Method:
@@ -49,5 +52,5 @@ def _ablation(part: str, signal: str) -> Method:
 
 
 for _part in ABLATIONS:
-    for _signal in ("stop",) if _part == "chains" else ("stop", "preference"):  # chains: stop queries only
+    for _signal in ("stop",) if _part in ("chains", "split") else ("stop", "preference"):  # stop queries only
         METHODS.register(f"decide-{_part}-{_signal}", lambda p=_part, s=_signal: _ablation(p, s))

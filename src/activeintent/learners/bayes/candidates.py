@@ -15,7 +15,7 @@ from activeintent import ranking
 from activeintent.envs.symbolic import symbolic_trajectory
 from activeintent.goals.facts import facts, state_key
 from activeintent.learners.bayes.hypotheses import Hypothesis
-from activeintent.world import Skill, WorldState
+from activeintent.world import Skill, WorldState, apply_skill
 from activeintent.world.trajectory import Trajectory
 
 
@@ -105,3 +105,103 @@ def chained_plans(
             if len(outs) >= limit:
                 return outs
     return outs
+
+
+def split_plans(
+    hyps: tuple[Hypothesis, ...],
+    weights: np.ndarray,
+    state: WorldState,
+    feasible: np.ndarray,
+    judge,
+    idx: np.ndarray,
+    starts: int = 3,
+    max_len: int = 6,
+    sources: int = 8,
+    seen: set[tuple] | None = None,
+    classes: np.ndarray | None = None,
+) -> list[Outcome]:
+    """Stop queries built to split the belief: a plan grown one step at a time, each step the
+    move (among the steps of the plans of the ``sources`` likeliest z not yet moved away from)
+    that moves away from as close to half of the remaining belief as it can. Where the person
+    stops then tells apart up to ``max_len`` + 1 groups of z (≈ 2 bits with exact answers), not
+    the two of a plan for one z. ``idx``: the particles judged (the likely z); ``starts``: plans
+    grown from the best different first steps. ``seen``: outcome keys already offered.
+    ``classes`` (the decision classes of z): split the classes, not z within one class."""
+    idx = idx[feasible[idx]]
+    if len(idx) < 2:
+        return []
+    w = weights[idx] / weights[idx].sum()
+    cls = None if classes is None else np.unique(classes[idx], return_inverse=True)[1].reshape(-1)
+
+    def gain(away: np.ndarray, alive: np.ndarray) -> float:
+        g = _split_bits(float(w[away].sum()), float(w[alive].sum()))
+        if cls is not None:  # I(stop step; class) = H(step) − H(step | class), exact answers
+            g -= sum(_split_bits(float(w[away & (cls == c)].sum()), float(w[alive & (cls == c)].sum()))
+                     for c in np.unique(cls[away]))
+        return g
+
+    seen = set(seen or ()) | {state_key(facts(state))}
+    outs: list[Outcome] = []
+    first: list[Skill] | None = None
+    for s in range(starts):
+        plan: list[Skill] = []
+        alive = np.ones(len(idx), dtype=bool)
+        cur = state
+        for t in range(max_len):
+            options = _next_steps(hyps, idx, alive, w, cur, sources)
+            if t == 0:
+                first = first if first is not None else _ranked_first(options, idx, cur, judge, gain)
+                options = first[s:s + 1]
+            best = None
+            for step in options:
+                after, fail = apply_skill(cur, step)
+                if fail is not None or after.positions == cur.positions:
+                    continue
+                away = judge.step_away(facts(cur), facts(after), step.block)[idx] & alive
+                g = gain(away, alive)
+                if best is None or g > best[0] + 1e-12:
+                    best = (g, step, after, away)
+            if best is None or best[0] < 1e-3:
+                break
+            plan.append(best[1])
+            cur, alive = best[2], alive & ~best[3]
+            if not alive.any():
+                break
+        if plan:
+            o = predict(state, plan)
+            if o.key not in seen:
+                seen.add(o.key)
+                outs.append(o)
+    return outs
+
+
+def _split_bits(x: float, a: float) -> float:
+    """a · H2(x / a): what splitting mass x off the remaining mass a adds to the partition's entropy."""
+    if x <= 0 or x >= a:
+        return 0.0
+    p = x / a
+    return a * float(-(p * np.log2(p) + (1 - p) * np.log2(1 - p)))
+
+
+def _next_steps(hyps, idx, alive, w, state: WorldState, sources: int) -> list[Skill]:
+    """Distinct steps of the plans, from ``state``, of the likeliest z still alive."""
+    order = [int(i) for i in np.argsort(-w, kind="stable") if alive[i]][:sources]
+    steps: dict[str, Skill] = {}
+    for i in order:
+        for p in hyps[idx[i]].plans(state):
+            for step in p:
+                steps.setdefault(repr(step), step)
+    return list(steps.values())
+
+
+def _ranked_first(options, idx, state: WorldState, judge, gain) -> list[Skill]:
+    """First steps, best split first (the different plans start from different moves)."""
+    scored = []
+    alive = np.ones(len(idx), dtype=bool)
+    for step in options:
+        after, fail = apply_skill(state, step)
+        if fail is not None or after.positions == state.positions:
+            continue
+        scored.append((gain(judge.step_away(facts(state), facts(after), step.block)[idx], alive), step))
+    scored.sort(key=lambda g: -g[0])
+    return [step for _, step in scored]

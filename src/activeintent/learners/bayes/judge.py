@@ -177,6 +177,12 @@ class HypothesisJudge:
         sat, score = self.judge(facts(state))
         return utility(score, sat)
 
+    def step_away(self, fb: Facts, fa: Facts, block: str, ok: bool = True) -> np.ndarray:
+        """Per z: does moving ``block`` (facts before → after) move away from z?"""
+        for h in self.hyps:
+            h.prefetch([fb, fa])
+        return first_away(self.hyps, [(fb, fa, block, ok)], self.token) == 0
+
     def first_away(self, traj: Trajectory) -> np.ndarray:
         hit = self._away.get(id(traj))
         if hit is not None and hit[0] is traj:

@@ -29,7 +29,12 @@ from activeintent.goals.facts import facts
 from activeintent.learners.base import Estimate, Learner, RoundRecord
 from activeintent.learners.bayes.acquisition import Query, particles, select_query
 from activeintent.learners.bayes.belief import Belief, Prior
-from activeintent.learners.bayes.candidates import candidate_plans, chained_plans, predict
+from activeintent.learners.bayes.candidates import (
+    candidate_plans,
+    chained_plans,
+    predict,
+    split_plans,
+)
 from activeintent.learners.bayes.decision import decision_classes, deployment_states
 from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space, random_scene
 from activeintent.learners.bayes.judge import HypothesisJudge
@@ -74,6 +79,8 @@ class BayesConfig(BaseModel):
                         "'new scene' answers (needs.py)")
     chains: int = Field(0, ge=0, description="stop queries: also offer plans of one of this many likely z "
                         "followed by another's (candidates.chained_plans); 0: none")
+    split: int = Field(0, ge=0, description="stop queries: also offer this many plans grown step by step so "
+                       "that each step moves away from about half of the likely z left (candidates.split_plans); 0: none")
     top_k: int = Field(16, ge=1, description="plans come from this many most probable hypotheses")
     explore: int = Field(6, ge=0, description="... plus this many random other hypotheses")
     max_plans: int = Field(36, ge=2, description="candidate plans per scene")
@@ -186,6 +193,12 @@ class BayesLearner(Learner):
         if c.chains and self.sig.shows == 1:
             outs += chained_plans(self.hyps, self.weights, state, feasible, first=c.chains,
                                   seen={o.key for o in outs})
+            feasible = self.judge.feasible(tuple(state.positions))
+        if c.split and self.sig.shows == 1:
+            outs += split_plans(self.hyps, self.weights, state, feasible, self.judge,
+                                particles(self.weights, mass=0.99, cap=256), starts=c.split,
+                                seen={o.key for o in outs},
+                                classes=self.decision_classes() if c.gain.endswith("decision") else None)
             feasible = self.judge.feasible(tuple(state.positions))
         return select_query(self.sig, self.model, self.judge, self.weights, feasible, outs,
                             c.new_scene_error, self.rng, choose=c.choose, gain=c.gain,

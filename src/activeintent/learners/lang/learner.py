@@ -59,6 +59,16 @@ class LangJudge(HypothesisJudge):
         holds, score = self.judge(facts(state))
         return utility(score, holds)
 
+    def step_away(self, fb: Facts, fa: Facts, block: str, ok: bool = True) -> np.ndarray:
+        """Per z: does moving ``block`` (facts before → after) move away from z? Its score
+        drops, or (a step that ran) the block left a place z allows."""
+        _, sb = self.judge(fb)
+        _, sa = self.judge(fa)
+        away = sa < sb - 1e-9
+        if ok:
+            away = away | self._cat(lambda sp: sp.compiled.moved_off(fb, fa, block))
+        return away
+
     def first_away(self, traj: Trajectory) -> np.ndarray:
         hit = self._away.get(id(traj))
         if hit is not None and hit[0] is traj:
@@ -67,12 +77,7 @@ class LangJudge(HypothesisJudge):
         for k, (fb, fa, block, ok) in enumerate(trajectory_steps(traj)):
             if fb is fa:
                 continue
-            _, sb = self.judge(fb)
-            _, sa = self.judge(fa)
-            away = sa < sb - 1e-9
-            if ok:
-                away = away | self._cat(lambda sp, fb=fb, fa=fa, block=block: sp.compiled.moved_off(fb, fa, block))
-            out[(out < 0) & away] = k
+            out[(out < 0) & self.step_away(fb, fa, block, ok)] = k
             if (out >= 0).all():
                 break
         if len(self._away) > 4096:
