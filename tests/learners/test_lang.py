@@ -245,3 +245,14 @@ def test_the_final_answer_can_satisfy_two_likely_goals_with_one_plan():
         got[joint] = (est.why["expected_success"], red.holds(facts(end)) + blue.holds(facts(end)))
     assert got[0] == (0.5, 1)
     assert got[2] == (1.0, 2)
+
+
+def test_the_space_checks_what_a_scene_allows_as_each_clause_does_alone():
+    """Compiled.possible shares groups and relation checks between clauses of one scene (a
+    memo): per clause its verdict equals the clause's own check, on every clause of the
+    language and random scenes."""
+    compiled = Compiled([Goal((c,), False) for c in CLAUSES])
+    rng = np.random.default_rng(4)
+    for _ in range(12):
+        objects = tuple(random_scene(rng).objects)
+        assert compiled.possible(objects).tolist() == [c.possible(objects) for c in CLAUSES]

@@ -1120,6 +1120,18 @@ def _groups(f: Facts) -> dict:
     return g
 
 
+def _split(objects: tuple[str, ...]) -> tuple[list[str], list[str]]:
+    """The blocks and the bowls of a scene's objects."""
+    return [o for o in objects if kind_of(o) == "block"], [o for o in objects if kind_of(o) == "bowl"]
+
+
+def _memo(memo: dict, key: tuple, compute):
+    got = memo.get(key, memo)  # the dict itself marks "not computed yet" (a verdict may be falsy)
+    if got is memo:
+        got = memo[key] = compute()
+    return got
+
+
 @dataclass(frozen=True)
 class Each:
     """``quant`` of the blocks picked by ``sel:sp`` satisfy ``rel:rp``."""
@@ -1202,14 +1214,18 @@ class Each:
             return ok and self.count(fa)[0] > int(self.quant[-1])
         return False
 
-    def possible(self, objects: tuple[str, ...]) -> bool:
+    def possible(self, objects: tuple[str, ...], memo: dict | None = None) -> bool:
+        """Static check in a scene of ``objects``; ``memo``: one dict per scene shared by many
+        clauses (groups and per-block relation checks are computed once)."""
+        memo = {} if memo is None else memo
         r = self.relation.refers(self.rp)
         if r is not None and r not in objects:
             return False
-        g = self.group([o for o in objects if kind_of(o) == "block"], [o for o in objects if kind_of(o) == "bowl"])
+        g = _memo(memo, ("group", self.sel, self.sp, r), lambda: self.group(*_split(objects)))
         if not g:
             return False
-        can = sum(self.relation.possible(b, objects, self.rp) for b in g)
+        can = sum(_memo(memo, ("rel", self.rel, self.rp, b), lambda b=b: self.relation.possible(b, objects, self.rp))
+                  for b in g)
         if self.quant == "every":
             return can == len(g)
         if self.quant == "none":
@@ -1291,9 +1307,11 @@ class Form:
         g = self.group_f(fa)
         return b in g and not self.structure.moved_ok(fb, fa, g, b, self.stp)
 
-    def possible(self, objects: tuple[str, ...]) -> bool:
-        g = self.group([o for o in objects if kind_of(o) == "block"], [o for o in objects if kind_of(o) == "bowl"])
-        return bool(g) and self.structure.possible(g, objects, self.stp)
+    def possible(self, objects: tuple[str, ...], memo: dict | None = None) -> bool:
+        memo = {} if memo is None else memo
+        g = _memo(memo, ("group", self.sel, self.sp, None), lambda: self.group(*_split(objects)))
+        return bool(g) and _memo(memo, ("structure", self.struct, self.stp, g),
+                                 lambda: self.structure.possible(g, objects, self.stp))
 
     def suggest(self, state: WorldState, f: Facts) -> list[Skill]:
         return self.structure.suggest(state, self.group_f(f), self.stp)

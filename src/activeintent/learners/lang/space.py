@@ -250,7 +250,8 @@ class Compiled:
         key = tuple(objects)
         got = self._possible.get(key)
         if got is None:
-            c = np.array([cl.possible(key) for cl in self.clauses] + [True], bool)
+            memo: dict = {}  # the clauses share their groups and relation checks in this scene
+            c = np.array([cl.possible(key, memo) for cl in self.clauses] + [True], bool)
             got = self._possible[key] = c[self.E].all(1)
             if len(self._possible) > 4096:
                 self._possible.clear()
