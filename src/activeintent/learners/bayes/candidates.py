@@ -140,27 +140,29 @@ def split_plans(
                      for c in np.unique(cls[away]))
         return g
 
+    def scored(cur: WorldState, alive: np.ndarray, options: list[Skill]):
+        """(gain, step, state after, z it moves away from) per step that moves something."""
+        for step in options:
+            after, fail = apply_skill(cur, step)
+            if fail is None and after.positions != cur.positions:
+                away = judge.step_away(facts(cur), facts(after), step.block)[idx] & alive
+                yield gain(away, alive), step, after, away
+
+    everyone = np.ones(len(idx), dtype=bool)
+    # the plans start from different moves: the best first steps, best first
+    first = [step for _, step, _, _ in sorted(scored(state, everyone, _next_steps(hyps, idx, everyone, w, state, sources)),
+                                              key=lambda g: -g[0])]
     seen = set(seen or ()) | {state_key(facts(state))}
     outs: list[Outcome] = []
-    first: list[Skill] | None = None
     for s in range(starts):
         plan: list[Skill] = []
-        alive = np.ones(len(idx), dtype=bool)
-        cur = state
+        alive, cur = everyone, state
         for t in range(max_len):
-            options = _next_steps(hyps, idx, alive, w, cur, sources)
-            if t == 0:
-                first = first if first is not None else _ranked_first(options, idx, cur, judge, gain)
-                options = first[s:s + 1]
+            options = first[s:s + 1] if t == 0 else _next_steps(hyps, idx, alive, w, cur, sources)
             best = None
-            for step in options:
-                after, fail = apply_skill(cur, step)
-                if fail is not None or after.positions == cur.positions:
-                    continue
-                away = judge.step_away(facts(cur), facts(after), step.block)[idx] & alive
-                g = gain(away, alive)
-                if best is None or g > best[0] + 1e-12:
-                    best = (g, step, after, away)
+            for cand in scored(cur, alive, options):
+                if best is None or cand[0] > best[0] + 1e-12:
+                    best = cand
             if best is None or best[0] < 1e-3:
                 break
             plan.append(best[1])
@@ -193,15 +195,3 @@ def _next_steps(hyps, idx, alive, w, state: WorldState, sources: int) -> list[Sk
                 steps.setdefault(repr(step), step)
     return list(steps.values())
 
-
-def _ranked_first(options, idx, state: WorldState, judge, gain) -> list[Skill]:
-    """First steps, best split first (the different plans start from different moves)."""
-    scored = []
-    alive = np.ones(len(idx), dtype=bool)
-    for step in options:
-        after, fail = apply_skill(state, step)
-        if fail is not None or after.positions == state.positions:
-            continue
-        scored.append((gain(judge.step_away(facts(state), facts(after), step.block)[idx], alive), step))
-    scored.sort(key=lambda g: -g[0])
-    return [step for _, step in scored]
