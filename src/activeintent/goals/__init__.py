@@ -4,7 +4,9 @@
 - language.py — the goal language: selectors, relations and structures in a registry, clauses,
   goals z, their sentences and description length L(z);
 - planner.py — one planner for every goal of the language, on the symbolic world model;
-- planning.py — placing helpers (free grid points, regions) the planners share.
+- planning.py — placing helpers (free grid points, areas) the planners share;
+- recipes.py — a node of the language over a whole group with a fixed plan: the leaves of the
+  bayes grammar (learners/bayes/hypotheses.py).
 
 Held-out suites never import this package: they are written with the world's helpers only, so
 that whether the language can say them is measured, not true by construction.

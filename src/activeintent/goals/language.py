@@ -34,7 +34,7 @@ from itertools import combinations, permutations
 import numpy as np
 
 from activeintent.goals.facts import ALIGN_TOL, Facts, facts
-from activeintent.goals.planning import GRID
+from activeintent.goals.planning import GRID, area_points
 from activeintent.registry import Registry
 from activeintent.world import BLOCK_SIZE, PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState
 from activeintent.world.colors import COLOR_NAMES, COOL_COLORS, WARM_COLORS
@@ -121,6 +121,12 @@ class Structure(Node):
 
     kind = "structure"
     min_size = 2
+
+    def __init__(self, min_size: int | None = None):
+        """``min_size``: the smallest group that can take the shape, when not the type's own
+        (a lone block is a tower / row / cluster of one in the bayes grammar's leaves)."""
+        if min_size is not None:
+            self.min_size = min_size
 
     def sentence(self, subject: str, p: str) -> str:  # subject: "the warm-coloured blocks"
         raise NotImplementedError
@@ -456,9 +462,7 @@ def region_points(region: str) -> list[tuple[float, float]]:
 
 def _area_points(inside) -> tuple[tuple[float, float], ...]:
     """The grid points ``inside`` holds, nearest their centre first."""
-    pts = [q for q in GRID if inside(q)]
-    cx, cy = float(np.mean([q[0] for q in pts])), float(np.mean([q[1] for q in pts]))
-    return tuple(sorted(pts, key=lambda q: (q[0] - cx) ** 2 + (q[1] - cy) ** 2))
+    return tuple(area_points(inside))
 
 
 @functools.cache  # planners ask on every step; the grid never changes
@@ -476,8 +480,64 @@ class InRegion(Relation):
     def ok(self, f, b, p):
         return b in f.on_table and f.below[b] is None and in_region(f, b, p)
 
+    def area(self, p: str):
+        """The region's test on a table point (x, y)."""
+        return REGIONS[p]
+
     def targets(self, state, b, p):
         return free_points(state, region_points(p), b, 10)
+
+
+# The cells of the table's 3 × 3 grid (world.relations' names) that no region above names.
+CELLS = {name: _cell(name) for name in ("top side", "left side", "middle", "right side", "bottom side")}
+
+
+class InCell(Relation):
+    """In one of the table's side cells or its middle cell, not in a bowl. Not registered: not in
+    the lang learners' language (registering it would change every goal's prior); the bayes
+    grammar's regions use it. Its "middle" is the grid cell, closed on two sides, where the
+    region "centre" is open."""
+
+    key = "cell"
+    params = tuple(CELLS)
+
+    def phrase(self, p):
+        return f"in the {p} cell of the table (not in a bowl)"
+
+    def ok(self, f, b, p):
+        return b in f.on_table and f.below[b] is None and f.cell[b] == p
+
+    def area(self, p: str):
+        return CELLS[p]
+
+    def targets(self, state, b, p):
+        return free_points(state, _area_points(CELLS[p]), b, 10)
+
+
+class Flat(Relation):
+    """``inner`` and flat on the table (not in a bowl, not on a block, nothing on it). Not
+    registered (see InCell): "flat on the table" and "next to …, flat on the table" of the
+    bayes grammar, where OnTable and NextTo allow a block with another one on top."""
+
+    def __init__(self, inner: Relation):
+        self.inner = inner
+        self.key = f"flat-{inner.key}"
+        self.params = inner.params
+
+    def phrase(self, p):
+        return f"{self.inner.phrase(p)}, flat on the table with nothing on it"
+
+    def ok(self, f, b, p):
+        return self.inner.ok(f, b, p) and f.flat(b)
+
+    def refers(self, p):
+        return self.inner.refers(p)
+
+    def possible(self, b, objects, p):
+        return self.inner.possible(b, objects, p)
+
+    def targets(self, state, b, p):
+        return self.inner.targets(state, b, p)
 
 
 # ---- structures --------------------------------------------------------------------------
@@ -525,6 +585,12 @@ class Line(Structure):
     sides = ("right", "left")
     words = ("one left-to-right row", "left to right")
 
+    def __init__(self, min_size: int | None = None, beside_any: bool = False):
+        """``beside_any``: a moved block set beside any block, not only one of the group, must be
+        in line with one of them (the bayes grammar's row and column)."""
+        super().__init__(min_size)
+        self.beside_any = beside_any
+
     def sentence(self, subject, p):
         text = f"{subject} form {self.words[0]} on the table, each next to its neighbour"
         return text + (f", {ORDER_WORDS[p]} {self.words[1]}" if p != "any" else "")
@@ -559,7 +625,7 @@ class Line(Structure):
         if not _flat(fa, b):
             return False
         v = fa.xy[b][self.axis]
-        near = [o for o in g if o != b and _flat(fa, o) and fa.next_to(b, o)]
+        near = [o for o in (fa.blocks if self.beside_any else g) if o != b and _flat(fa, o) and fa.next_to(b, o)]
         return not near or any(abs(fa.xy[o][self.axis] - v) <= ALIGN_TOL for o in near)
 
     def suggest(self, state, g, p):
@@ -593,13 +659,14 @@ class Column(Line):
     words = ("one front-to-back column", "front to back")
 
 
-def _towers(f: Facts, g: Group) -> list[list[str]]:
+def _towers(f: Facts, g: Group, on_table: bool = True) -> list[list[str]]:
     """Towers made only of group blocks, standing on the table (a pile in a bowl is no tower; a
-    lone block on the table is a tower of height 1), bottom to top."""
+    lone block on the table is a tower of height 1), bottom to top, tallest first; with
+    ``on_table`` False also those standing in a bowl."""
     gs = set(g)
     out = []
     for b in g:
-        if f.below[b] is None and b in f.on_table:
+        if f.below[b] is None and (b in f.on_table or not on_table):
             chain = f.tower(b)
             if all(c in gs for c in chain):
                 out.append(chain)
@@ -622,6 +689,12 @@ class Tower(Structure):
     key = "tower"
     params = ORDERS
 
+    def __init__(self, min_size: int | None = None, lone_flat: bool = False):
+        """``lone_flat``: a group of one block is a tower of height 1, so that block must stay flat
+        on the table when moved (the bayes grammar's tower, shown by lone blocks too)."""
+        super().__init__(min_size)
+        self.lone_flat = lone_flat
+
     def sentence(self, subject, p):
         return f"{subject} are stacked into one tower" + (f", {ORDER_WORDS[p]} from the bottom up" if p != "any" else "")
 
@@ -638,7 +711,12 @@ class Tower(Structure):
         return 1.0 if self.holds(f, g, p) else _ordered_height(f, g, p) / len(g)
 
     def moved_ok(self, fb, fa, g, b, p):
-        return fa.below[b] is not None or len(g) == 1
+        return fa.below[b] is not None or (len(g) == 1 and (not self.lone_flat or fa.flat(b)))
+
+    def bases(self, f: Facts, g: Group, p: str) -> list[str]:
+        """Where the tower can grow from, in any order (``p`` "any"): the bottoms of the group's
+        towers, tallest first."""
+        return [t[0] for t in _towers(f, g)]
 
     def suggest(self, state, g, p):
         f = facts(state)
@@ -709,6 +787,72 @@ class TwoTowers(Structure):
         return [PutOn(block=b, target=tower[-1]) for tower in t[:2] for b in g if b not in tower]
 
 
+class TwoTowersAnyHeights(Structure):
+    """Two towers of any heights, each of at least two blocks; scored by the share of blocks in
+    the two tallest such towers (TwoTowers: nearly equal heights). Not registered (see InCell):
+    the bayes grammar's two towers."""
+
+    key = "two-towers-any-heights"
+    min_size = 4
+
+    def sentence(self, subject, p):
+        return f"{subject} are stacked into two towers (any heights, at least two blocks each)"
+
+    def holds(self, f, g, p):
+        t = _towers(f, g)
+        return len(t) == 2 and all(len(x) >= 2 for x in t) and sum(map(len, t)) == len(g)
+
+    def _in_two(self, f, g) -> set[str]:
+        return {b for x in _towers(f, g)[:2] if len(x) >= 2 for b in x}
+
+    def score(self, f, g, p):
+        return len(self._in_two(f, g)) / len(g) if g else 1.0
+
+    def moved_ok(self, fb, fa, g, b, p):
+        return b in self._in_two(fa, g)
+
+    def suggest(self, state, g, p):
+        return TwoTowers().suggest(state, g, p)
+
+
+class TowerOnBlock(Structure):
+    """One tower whose bottom block is the named one, standing on the table or in a bowl (Tower:
+    on the table, any bottom block). Not registered (see InCell): the bayes grammar's tower on a
+    block. A lone block is judged as in Tower with ``lone_flat``."""
+
+    key = "tower-on"
+    params = COLOR_NAMES
+
+    def sentence(self, subject, p):
+        return f"{subject} are stacked into one tower on the {p} block"
+
+    def _growing(self, f, g, p) -> list[list[str]]:
+        """Towers anywhere that can become the tower: on the named block, or single blocks."""
+        return [t for t in _towers(f, g, on_table=False) if t[0] == f"{p} block" or len(t) == 1]
+
+    def holds(self, f, g, p):
+        full = [t for t in _towers(f, g, on_table=False) if len(t) == len(g)]
+        return bool(full) and full[0][0] == f"{p} block"
+
+    def score(self, f, g, p):
+        return max((len(t) for t in self._growing(f, g, p)), default=0) / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        return fa.below[b] is not None or (len(g) == 1 and fa.flat(b))
+
+    def possible(self, g, objects, p):
+        return f"{p} block" in g and len(g) >= self.min_size
+
+    def bases(self, f: Facts, g: Group, p: str) -> list[str]:
+        """Where the tower can grow from: the named block, when it is the bottom of a group tower."""
+        return [t[0] for t in _towers(f, g, on_table=False) if t[0] == f"{p} block"]
+
+    def suggest(self, state, g, p):
+        f = facts(state)
+        return [PutOn(block=b, target=f.tower(base)[-1]) for base in self.bases(f, g, p)
+                for b in g if b not in f.tower(base)]
+
+
 class OneBowl(Structure):
     key = "one-bowl"
     min_size = 2
@@ -734,7 +878,7 @@ class OneBowl(Structure):
         return fa.bowl_of[b] is not None and c[fa.bowl_of[b]] == max(c.values())
 
     def possible(self, g, objects, p):
-        return len(g) >= 2 and any(kind_of(o) == "bowl" for o in objects)
+        return len(g) >= self.min_size and any(kind_of(o) == "bowl" for o in objects)
 
     def suggest(self, state, g, p):
         c = self._counts(facts(state), g)
@@ -749,18 +893,18 @@ class SeparateBowls(Structure):
     def sentence(self, subject, p):
         return f"{subject} go in bowls, one block per bowl"
 
-    def _ok(self, f, g, b):
+    def block_ok(self, f, g, b):
         w = f.bowl_of[b]
         return w is not None and not any(o != b and f.bowl_of[o] == w for o in g)
 
     def holds(self, f, g, p):
-        return all(self._ok(f, g, b) for b in g)
+        return all(self.block_ok(f, g, b) for b in g)
 
     def score(self, f, g, p):
-        return sum(self._ok(f, g, b) for b in g) / len(g)
+        return sum(self.block_ok(f, g, b) for b in g) / len(g)
 
     def moved_ok(self, fb, fa, g, b, p):
-        return self._ok(fa, g, b)
+        return self.block_ok(fa, g, b)
 
     def possible(self, g, objects, p):
         return 1 <= len(g) <= sum(kind_of(o) == "bowl" for o in objects)
@@ -768,11 +912,17 @@ class SeparateBowls(Structure):
     def suggest(self, state, g, p):
         f = facts(state)
         used = {f.bowl_of[b] for b in g}
-        return [PutIn(block=b, bowl=w) for b in g if not self._ok(f, g, b) for w in state.bowls if w not in used]
+        return [PutIn(block=b, bowl=w) for b in g if not self.block_ok(f, g, b) for w in state.bowls if w not in used]
 
 
 class Cluster(Structure):
     key = "cluster"
+
+    def __init__(self, min_size: int | None = None, touching: bool = False):
+        """``touching``: a moved block must end next to another flat block of the group, unless
+        the group is that one block (the bayes grammar's cluster)."""
+        super().__init__(min_size)
+        self.touching = touching
 
     def sentence(self, subject, p):
         return f"{subject} are grouped together on the table, each touching another"
@@ -794,7 +944,9 @@ class Cluster(Structure):
         return max((len(self._comp(f, g, b)) for b in g if _flat(f, b)), default=0) / len(g)
 
     def moved_ok(self, fb, fa, g, b, p):
-        return _flat(fa, b)
+        if not self.touching:
+            return _flat(fa, b)
+        return _flat(fa, b) and (len(g) == 1 or any(o != b and _flat(fa, o) and fa.next_to(b, o) for o in g))
 
     def suggest(self, state, g, p):
         f = facts(state)
@@ -816,33 +968,33 @@ class Corners(Structure):
     def sentence(self, subject, p):
         return f"{subject} go on the table, each in a different corner"
 
-    def _corner(self, f, b):
+    def corner(self, f, b):
         if b not in f.on_table or f.below[b] is not None:
             return None
         return next((c for c in CORNERS if in_region(f, b, c)), None)
 
-    def _ok(self, f, g, b):
-        c = self._corner(f, b)
-        return c is not None and all(self._corner(f, o) != c for o in g if o != b)
+    def block_ok(self, f, g, b):
+        c = self.corner(f, b)
+        return c is not None and all(self.corner(f, o) != c for o in g if o != b)
 
     def holds(self, f, g, p):
-        return all(self._ok(f, g, b) for b in g)
+        return all(self.block_ok(f, g, b) for b in g)
 
     def score(self, f, g, p):
-        return sum(self._ok(f, g, b) for b in g) / len(g)
+        return sum(self.block_ok(f, g, b) for b in g) / len(g)
 
     def moved_ok(self, fb, fa, g, b, p):
-        return self._ok(fa, g, b)
+        return self.block_ok(fa, g, b)
 
     def possible(self, g, objects, p):
         return 1 <= len(g) <= 4
 
     def suggest(self, state, g, p):
         f = facts(state)
-        taken = {self._corner(f, o) for o in g}
+        taken = {self.corner(f, o) for o in g}
         out: list[Skill] = []
         for b in g:
-            if not self._ok(f, g, b):
+            if not self.block_ok(f, g, b):
                 for c in CORNERS:
                     if c not in taken:
                         out += free_points(state, region_points(c), b, 3)

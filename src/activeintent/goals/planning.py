@@ -1,7 +1,8 @@
-"""Small planning helpers for hypothesis planners, on the symbolic world model."""
+"""Small placing helpers for planners (free grid points, areas), on the symbolic world model."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import lru_cache
 
 import numpy as np
@@ -21,6 +22,38 @@ def grid_points(step: float = GRID_STEP) -> list[tuple[float, float]]:
 
 GRID = grid_points()
 
+
+def area_points(inside: Callable[[tuple[float, float]], bool], step: float = GRID_STEP) -> list[tuple[float, float]]:
+    """Grid points where ``inside`` holds, nearest their centre first (a new list: callers may
+    extend it). ``inside``: a region's test on a point, e.g. ``language.REGIONS[name]``."""
+    return list(_area_points(inside, step))
+
+
+@lru_cache(maxsize=256)  # a pure function of a fixed grid (the tests are module-level), asked on every planning step
+def _area_points(inside: Callable[[tuple[float, float]], bool], step: float) -> tuple[tuple[float, float], ...]:
+    pts = [p for p in (GRID if step == GRID_STEP else _fine_grid(step)) if inside(p)]
+    if not pts:
+        return ()
+    cx = float(np.mean([p[0] for p in pts]))
+    cy = float(np.mean([p[1] for p in pts]))
+    return tuple(sorted(pts, key=lambda p: (p[0] - cx) ** 2 + (p[1] - cy) ** 2))
+
+
+@lru_cache(maxsize=4)
+def _fine_grid(step: float) -> tuple[tuple[float, float], ...]:
+    return tuple(grid_points(step))
+
+
+def area_spots(inside: Callable[[tuple[float, float]], bool]) -> list[tuple[float, float]]:
+    """Where a block may be put down in an area: the usual grid points, then (when a bowl or
+    other blocks cover those of a small area) the points of a grid twice as fine."""
+    coarse = area_points(inside)
+    seen = set(coarse)
+    return coarse + [p for p in area_points(inside, GRID_STEP / 2) if p not in seen]
+
+
+# Named regions of the bayes behaviours (learners/bayes/behaviours.py), until its grammar takes
+# its leaves from goals/recipes.py.
 HALVES = {
     "left half": lambda xy: xy[0] < 0.0,
     "right half": lambda xy: xy[0] > 0.0,
@@ -49,11 +82,6 @@ def _region_points(region: str, step: float) -> tuple[tuple[float, float], ...]:
     cx = float(np.mean([p[0] for p in pts]))
     cy = float(np.mean([p[1] for p in pts]))
     return tuple(sorted(pts, key=lambda p: (p[0] - cx) ** 2 + (p[1] - cy) ** 2))
-
-
-@lru_cache(maxsize=4)
-def _fine_grid(step: float) -> tuple[tuple[float, float], ...]:
-    return tuple(grid_points(step))
 
 
 def region_spots(region: str) -> list[tuple[float, float]]:
