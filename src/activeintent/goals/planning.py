@@ -8,7 +8,6 @@ from functools import lru_cache
 import numpy as np
 
 from activeintent.world import BOUNDS, PutAt, Skill, SkillFailure, WorldState, apply_skill
-from activeintent.world.relations import table_position_name
 
 GRID_STEP = 0.06  # spacing of candidate free points (a block is 4 cm wide)
 
@@ -50,46 +49,6 @@ def area_spots(inside: Callable[[tuple[float, float]], bool]) -> list[tuple[floa
     coarse = area_points(inside)
     seen = set(coarse)
     return coarse + [p for p in area_points(inside, GRID_STEP / 2) if p not in seen]
-
-
-# Named regions of the bayes behaviours (learners/bayes/behaviours.py), until its grammar takes
-# its leaves from goals/recipes.py.
-HALVES = {
-    "left half": lambda xy: xy[0] < 0.0,
-    "right half": lambda xy: xy[0] > 0.0,
-    "top half": lambda xy: xy[1] > -0.5,
-    "bottom half": lambda xy: xy[1] < -0.5,
-}
-
-
-def in_region(region: str, xy: tuple[float, float]) -> bool:
-    """``region``: a table-position name (corner, side, middle) or a half of the table."""
-    if region in HALVES:
-        return HALVES[region](xy)
-    return table_position_name(xy) == region
-
-
-def region_points(region: str, step: float = GRID_STEP) -> list[tuple[float, float]]:
-    """Grid points of ``region``, nearest its centre first (a new list: callers may extend it)."""
-    return list(_region_points(region, step))
-
-
-@lru_cache(maxsize=256)  # a pure function of a fixed grid, asked for on every planning step
-def _region_points(region: str, step: float) -> tuple[tuple[float, float], ...]:
-    pts = [p for p in (GRID if step == GRID_STEP else _fine_grid(step)) if in_region(region, p)]
-    if not pts:
-        return ()
-    cx = float(np.mean([p[0] for p in pts]))
-    cy = float(np.mean([p[1] for p in pts]))
-    return tuple(sorted(pts, key=lambda p: (p[0] - cx) ** 2 + (p[1] - cy) ** 2))
-
-
-def region_spots(region: str) -> list[tuple[float, float]]:
-    """Where a block may be put down in ``region``: the usual grid points, then (when a bowl or
-    other blocks cover those of a small cell) the points of a grid twice as fine."""
-    coarse = region_points(region)
-    seen = set(coarse)
-    return coarse + [p for p in region_points(region, GRID_STEP / 2) if p not in seen]
 
 
 def step_ok(state: WorldState, step: Skill) -> WorldState | None:

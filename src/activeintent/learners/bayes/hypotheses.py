@@ -2,7 +2,8 @@
 
 A hypothesis is one or two *clauses*; a clause says what a set of blocks (all blocks, the
 warm-coloured ones or the cool-coloured ones, see ``world.colors``) should do, by a
-*behaviour* (behaviours.py): a per-block target rule or a structure over the group.
+*behaviour*: a leaf of the goal language (``goals.recipes``) — a relation every block of the
+group satisfies, or a structure the group takes — under the grammar's name and wording.
 
     H      → all: B_all | class: B_class | warm: B_pair, cool: B_pair
     class  → warm | cool
@@ -26,11 +27,40 @@ from pathlib import Path
 import numpy as np
 
 from activeintent.goals.facts import Facts, facts, is_cool, is_warm
-from activeintent.goals.planning import HALVES, run
+from activeintent.goals.language import (
+    Cluster,
+    Column,
+    Corners,
+    Flat,
+    InBowl,
+    InCell,
+    InNamedBowl,
+    InRegion,
+    NextTo,
+    OneBowl,
+    OnTable,
+    Row,
+    SeparateBowls,
+    Tower,
+    TowerOnBlock,
+    TwoTowersAnyHeights,
+)
+from activeintent.goals.planning import run
+from activeintent.goals.recipes import (
+    EveryBlock,
+    FlatDown,
+    Gather,
+    IntoArea,
+    IntoCorners,
+    IntoOneBowl,
+    Leaf,
+    LineUp,
+    OnePerBowl,
+    Stack,
+    TwoStacks,
+)
 from activeintent.intentions.base import Intention
-from activeintent.learners.bayes import behaviours as bh
 from activeintent.world import COLOR_NAMES, Scene, Skill, WorldState, layout, sample_scene
-from activeintent.world.skills import TABLE_POSITIONS
 
 SELECTORS = {
     "all": lambda b: True,
@@ -42,17 +72,51 @@ SUBJECTS = {
     "warm": "the warm-coloured blocks (red, orange, yellow, pink, brown)",
     "cool": "the cool-coloured blocks (blue, green, purple, cyan, gray)",
 }
-REGIONS = tuple(TABLE_POSITIONS) + tuple(HALVES)
+# The grammar's regions of the table — its nine cells (world.skills.TABLE_POSITIONS) and its
+# halves — as the language says them: corners and halves are regions, the other cells cells.
+_REGION, _CELL = InRegion(), InCell()
+REGIONS = {
+    "top left corner": (_REGION, "back left corner"), "top side": (_CELL, "top side"),
+    "top right corner": (_REGION, "back right corner"), "left side": (_CELL, "left side"),
+    "middle": (_CELL, "middle"), "right side": (_CELL, "right side"),
+    "bottom left corner": (_REGION, "front left corner"), "bottom side": (_CELL, "bottom side"),
+    "bottom right corner": (_REGION, "front right corner"),
+    "left half": (_REGION, "left half"), "right half": (_REGION, "right half"),
+    "top half": (_REGION, "back half"), "bottom half": (_REGION, "front half"),
+}
+
+
+@dataclass(frozen=True)
+class Behaviour:
+    """B: what a group should do — a leaf of the goal language (its meaning, judge and plans)
+    under the grammar's name (``family``, ``param``) and wording ("{s}": the subject, "{p}":
+    the parameter)."""
+
+    family: str
+    wording: str
+    leaf: Leaf
+    param: str | None = None
+
+    @property
+    def key(self) -> str:
+        return self.family + (f"[{self.param}]" if self.param else "")
+
+    def phrase(self, subject: str) -> str:
+        return self.wording.format(s=subject, p=self.param)
 
 
 @dataclass(frozen=True)
 class Clause:
     selector: str  # "all" | "warm" | "cool"
-    behaviour: bh.Behaviour
+    behaviour: Behaviour
+
+    @property
+    def leaf(self) -> Leaf:
+        return self.behaviour.leaf
 
     def group(self, blocks: tuple[str, ...] | list[str]) -> tuple[str, ...]:
         sel = SELECTORS[self.selector]
-        skip = self.behaviour.excluded()
+        skip = self.leaf.excluded()
         return tuple(b for b in blocks if sel(b) and b != skip)
 
     def judge_f(self, f: Facts) -> tuple[bool, float, int]:
@@ -61,11 +125,11 @@ class Clause:
         got = f.memo.get(key)
         if got is None:
             g = self.group_f(f)
-            got = f.memo[key] = (self.behaviour.holds(f, g), self.behaviour.score(f, g), len(g))
+            got = f.memo[key] = (*self.leaf.judge(f, g), len(g))
         return got
 
     def group_f(self, f: Facts) -> tuple[str, ...]:
-        key = (self.selector, self.behaviour.excluded())
+        key = (self.selector, self.leaf.excluded())
         g = f.memo.get(key)
         if g is None:
             g = f.memo[key] = self.group(f.blocks)
@@ -85,7 +149,7 @@ class Hypothesis(Intention):
         parts = []
         for c in self.clauses:
             subject = SUBJECTS[c.selector]
-            if c.behaviour.excluded():
+            if c.leaf.excluded():
                 subject = "the other blocks" if c.selector == "all" else f"the other {subject[4:]}"
             parts.append(c.behaviour.phrase(subject))
         text = " and ".join(parts)
@@ -123,7 +187,7 @@ class Hypothesis(Intention):
         """Is the moved block's new place inconsistent with z (the score aside)?"""
         for c in self.clauses:
             g = c.group_f(fa)
-            if block in g and not c.behaviour.moved_ok(fb, fa, g, block):
+            if block in g and not c.leaf.moved_ok(fb, fa, g, block):
                 return True
         return False
 
@@ -139,7 +203,7 @@ class Hypothesis(Intention):
         blocks = scene.blocks
         for c in self.clauses:
             g = c.group(blocks)
-            if not g or not c.behaviour.feasible(objects, g):
+            if not g or not c.leaf.feasible(objects, g):
                 return False
         return True
 
@@ -158,11 +222,11 @@ class Hypothesis(Intention):
         """Distinct plans that satisfy z from ``state`` (first = the canonical one)."""
         out: list[list[Skill]] = []
         seen: set[str] = set()
-        n = variants or max(c.behaviour.variants for c in self.clauses)
+        n = variants or max(c.leaf.variants for c in self.clauses)
         for v in range(n):
             s, steps = state, []
             for c in self.clauses:
-                got = c.behaviour.plan(s, c.group(s.blocks), v)
+                got = c.leaf.plan(s, c.group(s.blocks), v)
                 if got is None:
                     break
                 s, more = got
@@ -190,25 +254,47 @@ def random_scene(rng: np.random.Generator) -> Scene:
 
 # ---- the grammar -------------------------------------------------------------------------
 
-ALL_FAMILIES: list[tuple[str, list[bh.Behaviour]]] = [
-    ("in-same-bowl", [bh.InSameBowl()]),
-    ("in-other-bowl", [bh.InOtherBowl()]),
-    ("in-any-bowl", [bh.InAnyBowl()]),
-    ("on-table", [bh.OnTable()]),
-    ("next-to-same-bowl", [bh.NextToSameBowl()]),
-    ("tower", [bh.Tower()]),
-    ("distinct-corners", [bh.DistinctCorners()]),
-    ("row", [bh.Row()]),
-    ("column", [bh.Column()]),
-    ("cluster", [bh.Cluster()]),
-    ("one-bowl", [bh.OneBowl()]),
-    ("distinct-bowls", [bh.DistinctBowls()]),
-    ("two-towers", [bh.TwoTowers()]),
-    ("in-bowl", [bh.InBowl(c) for c in COLOR_NAMES]),
-    ("next-to-bowl", [bh.NextToBowl(c) for c in COLOR_NAMES]),
-    ("next-to-block", [bh.NextToBlock(c) for c in COLOR_NAMES]),
-    ("tower-on", [bh.TowerOn(c) for c in COLOR_NAMES]),
-    ("region", [bh.InRegion(r) for r in REGIONS]),
+def _family(name: str, wording: str, leaves: dict[str | None, Leaf]) -> tuple[str, list[Behaviour]]:
+    """A family of behaviours: one per parameter (None: the family has none)."""
+    return name, [Behaviour(name, wording, leaf, param) for param, leaf in leaves.items()]
+
+
+# Where the language's nodes are stricter or looser than the grammar's words, the leaves use the
+# nodes' explicit options: flat (nothing on top) for "on the table" and "next to", lone blocks
+# showing a tower / row / column / cluster / one bowl, moves checked against every neighbour.
+ALL_FAMILIES: list[tuple[str, list[Behaviour]]] = [
+    _family("in-same-bowl", "{s} go in the bowl of their own colour", {None: EveryBlock(InBowl(), "same")}),
+    _family("in-other-bowl", "{s} go in a bowl of a different colour",
+            {None: EveryBlock(InBowl(), "other", variants=3, spread_from=2)}),
+    _family("in-any-bowl", "{s} go in bowls (any bowl)", {None: EveryBlock(InBowl(), "any", variants=3, spread_from=0)}),
+    _family("on-table", "{s} stay flat on the table (not in bowls, not stacked)", {None: FlatDown(Flat(OnTable()))}),
+    _family("next-to-same-bowl", "{s} go on the table next to the bowl of their own colour",
+            {None: EveryBlock(Flat(NextTo()), "own-bowl")}),
+    _family("tower", "{s} are stacked into one tower", {None: Stack(Tower(min_size=1, lone_flat=True), "any", variants=3)}),
+    _family("distinct-corners", "{s} go on the table, each in a different corner of the table",
+            {None: IntoCorners(Corners())}),
+    _family("row", "{s} are aligned horizontally in one left-right row on the table",
+            {None: LineUp(Row(min_size=1, beside_any=True), "any", variants=3)}),
+    _family("column", "{s} are aligned vertically in one front-back column on the table",
+            {None: LineUp(Column(min_size=1, beside_any=True), "any", variants=3)}),
+    _family("cluster", "{s} are grouped together on the table, each touching another",
+            {None: Gather(Cluster(min_size=1, touching=True), variants=2)}),
+    # no blocks are in no bowl, and are not two towers
+    _family("one-bowl", "{s} all go in one bowl together",
+            {None: IntoOneBowl(OneBowl(min_size=1), variants=3, empty=(False, 1.0))}),
+    _family("distinct-bowls", "{s} go in bowls, one block per bowl", {None: OnePerBowl(SeparateBowls(), variants=2)}),
+    _family("two-towers", "{s} are stacked into two towers",
+            {None: TwoStacks(TwoTowersAnyHeights(), variants=2, empty=(False, 1.0))}),
+    _family("in-bowl", "{s} go in the {p} bowl", {c: EveryBlock(InNamedBowl(), c) for c in COLOR_NAMES}),
+    # at most four blocks fit around one object
+    _family("next-to-bowl", "{s} go on the table next to the {p} bowl",
+            {c: EveryBlock(Flat(NextTo()), f"{c} bowl", max_group=4) for c in COLOR_NAMES}),
+    _family("next-to-block", "{s} go on the table next to the {p} block",
+            {c: EveryBlock(Flat(NextTo()), f"{c} block", max_group=4) for c in COLOR_NAMES}),
+    _family("tower-on", "{s} are stacked into one tower on the {p} block",
+            {c: Stack(TowerOnBlock(), c, variants=2) for c in COLOR_NAMES}),
+    _family("region", "{s} go to the {p} of the table (not in bowls)",
+            {name: IntoArea(rel, p) for name, (rel, p) in REGIONS.items()}),
 ]
 CLASS_FAMILIES = [
     (name, members)
@@ -220,7 +306,7 @@ PAIR_FAMILIES = [
     f[1][0] for f in CLASS_FAMILIES
     if f[0] in {"in-same-bowl", "in-other-bowl", "in-any-bowl", "on-table", "next-to-same-bowl",
                 "tower", "row", "column", "cluster", "one-bowl"}
-] + [bh.InRegion("left half"), bh.InRegion("right half")]
+] + [b for name, members in ALL_FAMILIES if name == "region" for b in members if b.param in ("left half", "right half")]
 STRUCTURES = 3  # all blocks / one colour class / both colour classes
 
 
@@ -272,12 +358,13 @@ def _bank(seed: int, others: int) -> list[tuple[Scene, list[Facts]]]:
 
 
 def _cache_sources() -> list[Path]:
-    """Every source file the cached result depends on: the grammar, the facts and placing helpers
-    it is built on, all of world/, intentions/."""
+    """Every source file the cached result depends on: the grammar, the goal language's nodes and
+    recipes its leaves are (and the facts, placing helpers and node registry they are built on),
+    all of world/, intentions/."""
     pkg = Path(__file__).resolve().parents[2]
-    bayes = [pkg / "learners" / "bayes" / name for name in ("hypotheses.py", "behaviours.py")]
-    goals = [pkg / "goals" / name for name in ("facts.py", "planning.py")]
-    return bayes + goals + sorted((pkg / "world").glob("*.py")) + sorted((pkg / "intentions").glob("*.py"))
+    goals = [pkg / "goals" / name for name in ("facts.py", "language.py", "planning.py", "recipes.py")]
+    return [pkg / "learners" / "bayes" / "hypotheses.py", *goals, pkg / "registry.py",
+            *sorted((pkg / "world").glob("*.py")), *sorted((pkg / "intentions").glob("*.py"))]
 
 
 def _cache_file(seed: int, others: int, sources: list[Path] | None = None) -> Path:

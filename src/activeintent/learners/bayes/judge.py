@@ -58,7 +58,7 @@ class _Clauses:
                 continue
             c = self.clauses[ci]
             g = c.group_f(fa)
-            off[ci] = block in g and not c.behaviour.moved_ok(fb, fa, g, block)
+            off[ci] = block in g and not c.leaf.moved_ok(fb, fa, g, block)
         return off[self.idx[rows]].any(axis=1)
 
 
