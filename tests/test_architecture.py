@@ -184,3 +184,33 @@ def test_every_plug_in_point_is_one_registry():
     second = [name for name, path in MODULES.items() if name != "activeintent.registry"
               and re.search(r"^class \w*Registry\b|^_BUILTIN\b", path.read_text(), re.M)]
     assert not second, f"a second registry: {second}"
+
+
+def test_one_vocabulary_of_goals():
+    """The bayes grammar's leaves are nodes of the goal language (goals/), not a second vocabulary
+    of its own: learners/bayes/behaviours.py is gone, hypotheses.py imports its leaves from goals/
+    and nothing else of the learners, and every leaf is built from goals classes."""
+    assert not (SRC / "learners" / "bayes" / "behaviours.py").exists()
+    grammar = imports(MODULES["activeintent.learners.bayes.hypotheses"])
+    assert {"activeintent.goals.language", "activeintent.goals.recipes"} <= grammar
+    assert not [m for m in grammar if m.startswith("activeintent.learners")], grammar
+
+    from activeintent.goals.recipes import Leaf
+    from activeintent.learners.bayes.hypotheses import ALL_FAMILIES
+
+    for family, behaviours in ALL_FAMILIES:
+        for b in behaviours:
+            assert isinstance(b.leaf, Leaf), family
+            parts = [b.leaf] + [getattr(b.leaf, a) for a in ("rel", "struct") if hasattr(b.leaf, a)]
+            parts += [p.inner for p in parts if hasattr(p, "inner")]  # Flat(NextTo()) and the like
+            assert all(type(p).__module__.startswith("activeintent.goals.") for p in parts), (family, parts)
+
+
+@pytest.mark.parametrize("suite", ["heldout", "heldout2"])
+def test_held_out_suites_stay_independent_of_the_goal_language(suite):
+    """Written blind with the world's helpers only (also at run time: lazy imports count), so
+    that whether the language can say them is measured, not true by construction."""
+    path = SRC / "intentions" / "suites" / f"{suite}.py"
+    assert path.exists()
+    found = imports(path) | runtime_imports(path)
+    assert not [m for m in found if m.startswith("activeintent.goals")], found
