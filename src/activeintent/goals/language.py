@@ -551,6 +551,11 @@ def _flat(f: Facts, b: str) -> bool:
     return b in f.on_table and f.below[b] is None and f.above[b] is None
 
 
+def _rests_on_table(f: Facts, b: str) -> bool:
+    """Directly on the table (not in a bowl, not on a block); another block may stand on it."""
+    return b in f.on_table and f.below[b] is None
+
+
 ORDERS = ("any", "rainbow", "warm-first", "cool-first")
 ORDER_WORDS = {"rainbow": "in rainbow order", "warm-first": "the warm-coloured ones first",
                "cool-first": "the cool-coloured ones first"}
@@ -585,18 +590,25 @@ class Line(Structure):
     sides = ("right", "left")
     words = ("one left-to-right row", "left to right")
 
-    def __init__(self, min_size: int | None = None, beside_any: bool = False):
+    def __init__(self, min_size: int | None = None, beside_any: bool = False, loaded: bool = False):
         """``beside_any``: a moved block set beside any block, not only one of the group, must be
-        in line with one of them (the bayes grammar's row and column)."""
+        in line with one of them (the bayes grammar's row and column). ``loaded``: a block of
+        the line only has to rest on the table, another block may stand on it (the library's
+        align and align-vertical; by default the blocks of a line are flat, nothing on them)."""
         super().__init__(min_size)
         self.beside_any = beside_any
+        self.loaded = loaded
+
+    def member(self, f: Facts, b: str) -> bool:
+        """Can ``b`` be part of a line where it stands?"""
+        return _rests_on_table(f, b) if self.loaded else _flat(f, b)
 
     def sentence(self, subject, p):
         text = f"{subject} form {self.words[0]} on the table, each next to its neighbour"
         return text + (f", {ORDER_WORDS[p]} {self.words[1]}" if p != "any" else "")
 
     def line(self, f: Facts, blocks, p: str) -> bool:
-        if len(blocks) < 1 or not all(_flat(f, b) for b in blocks):
+        if len(blocks) < 1 or not all(self.member(f, b) for b in blocks):
             return False
         across = [f.xy[b][self.axis] for b in blocks]
         if max(across) - min(across) > ALIGN_TOL:
@@ -611,7 +623,7 @@ class Line(Structure):
         return self.line(f, g, p)
 
     def best(self, f: Facts, g: Group, p: str) -> tuple[str, ...]:
-        flat = [b for b in g if _flat(f, b)]
+        flat = [b for b in g if self.member(f, b)]
         for size in range(len(flat), 1, -1):
             for c in combinations(flat, size):
                 if self.line(f, c, p):
@@ -622,10 +634,10 @@ class Line(Structure):
         return len(self.best(f, g, p)) / len(g) if g else 1.0
 
     def moved_ok(self, fb, fa, g, b, p):
-        if not _flat(fa, b):
+        if not self.member(fa, b):
             return False
         v = fa.xy[b][self.axis]
-        near = [o for o in (fa.blocks if self.beside_any else g) if o != b and _flat(fa, o) and fa.next_to(b, o)]
+        near = [o for o in (fa.blocks if self.beside_any else g) if o != b and self.member(fa, o) and fa.next_to(b, o)]
         return not near or any(abs(fa.xy[o][self.axis] - v) <= ALIGN_TOL for o in near)
 
     def suggest(self, state, g, p):
@@ -689,11 +701,14 @@ class Tower(Structure):
     key = "tower"
     params = ORDERS
 
-    def __init__(self, min_size: int | None = None, lone_flat: bool = False):
+    def __init__(self, min_size: int | None = None, lone_flat: bool = False, onto_standing: bool = False):
         """``lone_flat``: a group of one block is a tower of height 1, so that block must stay flat
-        on the table when moved (the bayes grammar's tower, shown by lone blocks too)."""
+        on the table when moved (the bayes grammar's tower, shown by lone blocks too).
+        ``onto_standing``: a moved block must end on a block of a tower standing on the table (a
+        pile in a bowl is no tower, a lone block is not stacked): the library's stack."""
         super().__init__(min_size)
         self.lone_flat = lone_flat
+        self.onto_standing = onto_standing
 
     def sentence(self, subject, p):
         return f"{subject} are stacked into one tower" + (f", {ORDER_WORDS[p]} from the bottom up" if p != "any" else "")
@@ -711,6 +726,8 @@ class Tower(Structure):
         return 1.0 if self.holds(f, g, p) else _ordered_height(f, g, p) / len(g)
 
     def moved_ok(self, fb, fa, g, b, p):
+        if self.onto_standing:
+            return fa.below[b] is not None and any(b in t for t in _towers(fa, g))
         return fa.below[b] is not None or (len(g) == 1 and (not self.lone_flat or fa.flat(b)))
 
     def bases(self, f: Facts, g: Group, p: str) -> list[str]:
@@ -766,6 +783,13 @@ class TwoTowers(Structure):
     key = "two-towers"
     min_size = 3
 
+    def __init__(self, min_size: int | None = None, onto_standing: bool = False):
+        """``onto_standing``: a moved block must end on a block of a tower standing on the table
+        and no taller than the taller of the two wanted towers (the library's two-towers; by
+        default being on a block is enough)."""
+        super().__init__(min_size)
+        self.onto_standing = onto_standing
+
     def sentence(self, subject, p):
         return f"{subject} are stacked into two towers of (nearly) equal height"
 
@@ -780,7 +804,10 @@ class TwoTowers(Structure):
         return got / len(g) if len(t) >= 2 else min(len(t[0]) if t else 0, want[0]) / len(g)
 
     def moved_ok(self, fb, fa, g, b, p):
-        return fa.below[b] is not None
+        if not self.onto_standing or fa.below[b] is None:
+            return fa.below[b] is not None
+        tower = next((t for t in _towers(fa, g) if b in t), None)
+        return tower is not None and len(tower) <= (len(g) + 1) // 2
 
     def suggest(self, state, g, p):
         t = _towers(facts(state), g)
@@ -853,9 +880,52 @@ class TowerOnBlock(Structure):
                 for b in g if b not in f.tower(base)]
 
 
+class BottomOfTower(Structure):
+    """The group stacked as the bottom of one tower standing on the table; blocks of other
+    groups may stand on top (Tower: the tower is the group's alone). A block is placed when it
+    is in the longest run of group blocks from the base of a standing tower (ties: the first
+    of the towers, tallest first). Not registered (see InCell): the library's
+    warm-in-bowls-cool-stacked stacks its cool blocks so."""
+
+    key = "bottom-of-tower"
+    min_size = 1
+
+    def sentence(self, subject, p):
+        return f"{subject} are stacked into one tower on the table, other blocks may stand on top"
+
+    def run(self, f: Facts, g: Group) -> list[str]:
+        towers = sorted((f.tower(b) for b in f.blocks if f.below[b] is None and b in f.on_table), key=len, reverse=True)
+        best: list[str] = []
+        for tower in towers:
+            n = next((i for i, b in enumerate(tower) if b not in g), len(tower))
+            if n > len(best):
+                best = tower[:n]
+        return best
+
+    def holds(self, f, g, p):
+        return len(self.run(f, g)) == len(g)
+
+    def score(self, f, g, p):
+        return len(self.run(f, g)) / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        return b in self.run(fa, g)
+
+    def suggest(self, state, g, p):
+        run = self.run(facts(state), g)
+        return [PutOn(block=b, target=run[-1]) for b in g if b not in run] if run else []
+
+
 class OneBowl(Structure):
     key = "one-bowl"
     min_size = 2
+
+    def __init__(self, min_size: int | None = None, into_used: bool = False):
+        """``into_used``: a moved block must end in a bowl, one that already held another block of
+        the group before the move when any did (the library's one-bowl; by default a fullest
+        bowl after the move)."""
+        super().__init__(min_size)
+        self.into_used = into_used
 
     def sentence(self, subject, p):
         return f"{subject} all go together in one bowl"
@@ -873,7 +943,16 @@ class OneBowl(Structure):
     def score(self, f, g, p):
         return max(self._counts(f, g).values(), default=0) / len(g)
 
+    def fullest(self, f: Facts, g: Group) -> str | None:
+        """The bowl holding the most blocks of the group (ties: the first in the state), None
+        without bowls."""
+        c = self._counts(f, g)
+        return max(f.bowls, key=lambda w: (c.get(w, 0), -f.bowls.index(w)), default=None)
+
     def moved_ok(self, fb, fa, g, b, p):
+        if self.into_used:
+            used = {fb.bowl_of[o] for o in g if o != b} - {None}
+            return fa.bowl_of[b] is not None and (not used or fa.bowl_of[b] in used)
         c = self._counts(fa, g)
         return fa.bowl_of[b] is not None and c[fa.bowl_of[b]] == max(c.values())
 
