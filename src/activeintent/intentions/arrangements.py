@@ -1,6 +1,11 @@
 """Intentions that arrange blocks relative to each other: rows, columns, towers (paper: align,
 stack), and warm blocks in bowls with cool blocks stacked.
 
+What a state must satisfy, its score and which moves go against it are the goal language's
+(activeintent.goals): Row / Column, Tower, TwoTowers, InBowl and BottomOfTower over all the
+blocks, with the options that say these intentions' own readings. Scenes and oracle plans are
+the protocol's and stay here.
+
 Geometry matches world.predict: PutNextTo leaves neighbouring blocks ROW_PITCH = 5.2 cm apart
 (centre to centre) at exactly the target's other coordinate, and world.relations calls two
 blocks next to each other when the gap between their footprints is under 5 cm.
@@ -12,21 +17,21 @@ from itertools import combinations
 
 import numpy as np
 
+from activeintent.goals.facts import Facts, facts
+from activeintent.goals.language import BottomOfTower, ColourClass, Column, InBowl, Line, Row, Tower
+from activeintent.goals.language import TwoTowers as TwoTowersNode
 from activeintent.intentions.base import Intention
 from activeintent.intentions.blockwise import BlockwiseIntention
 from activeintent.intentions.placement import (
-    LINE_TOL,
     ROW_PITCH,
     TABLE_INNER,
     grid,
     is_clear,
-    is_warm,
     nearest_first,
     on_table,
     park,
     standing_towers,
     top_first,
-    towers,
     verified,
 )
 from activeintent.world import (
@@ -45,8 +50,6 @@ from activeintent.world import (
     relations,
 )
 
-MIN_SPACING = 0.03  # two blocks on one surface closer than this would overlap
-
 
 def _two_to_four_blocks(rng: np.random.Generator) -> Scene:
     """2–4 blocks and up to 2 bowls (3–5 objects): the scenes of the row and tower intentions."""
@@ -62,60 +65,29 @@ def _blocks_and_bowls(rng: np.random.Generator, n_blocks: int, n_bowls: int) -> 
 
 
 class _LineIntention(Intention):
-    """All blocks in one straight line on the table, neighbours next to each other.
+    """All blocks in one straight line on the table, neighbours next to each other: the goal
+    language's Row / Column over all the blocks (``node``), where a block of the line may carry
+    another one (``loaded``)."""
 
-    ``axis`` is the coordinate along the line (0: x, a left-right row; 1: y, a front-back
-    column); the other coordinate may spread by at most LINE_TOL.
-    """
-
-    axis: int = 0
+    node: Line
+    axis: int = 0  # the coordinate along the line, for the plans (0: x, 1: y)
     sides: tuple[str, str] = ("right", "left")
 
     def line_ok(self, state: WorldState, rel: Relations, members: list[str] | tuple[str, ...]) -> bool:
-        if not members or not all(on_table(rel, b) for b in members):
-            return False
-        across = [state.pos(b)[1 - self.axis] for b in members]
-        if max(across) - min(across) > LINE_TOL:
-            return False
-        ordered = sorted(members, key=lambda b: state.pos(b)[self.axis])
-        for a, b in zip(ordered, ordered[1:], strict=False):
-            if state.pos(b)[self.axis] - state.pos(a)[self.axis] < MIN_SPACING or not rel.is_next_to(a, b):
-                return False
-        return True
-
-    def longest_line(self, state: WorldState, rel: Relations) -> int:
-        candidates = [b for b in state.blocks if on_table(rel, b)]
-        for size in range(len(candidates), 1, -1):
-            if any(self.line_ok(state, rel, combo) for combo in combinations(candidates, size)):
-                return size
-        return 1 if candidates else 0
+        return self.node.line(facts(state), tuple(members), "any")
 
     def satisfied(self, state: WorldState) -> bool:
-        return self.line_ok(state, relations(state), state.blocks)
+        return self.node.holds(facts(state), tuple(state.blocks), "any")
 
     def score(self, state: WorldState) -> float:
-        n = len(state.blocks)
-        return self.longest_line(state, relations(state)) / n if n else 0.0
+        return self.node.score(facts(state), tuple(state.blocks), "any") if state.blocks else 0.0
 
     def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
         if self.score(after) < self.score(before) - 1e-9:
             return True
-        rel = relations(after)
-        block = step.block
-        if block not in after.positions or block not in after.blocks:
+        if step.block not in after.positions or step.block not in after.blocks:
             return False
-        if not on_table(rel, block):  # stacked or in a bowl: never part of the line
-            return True
-        across = after.pos(block)[1 - self.axis]
-        # Set beside blocks but in line with none of them (e.g. in front of a block when a
-        # row is wanted). Touching a not-yet-moved block crosswise while joining the row is fine.
-        neighbours = [
-            other for other in after.blocks
-            if other != block and on_table(rel, other) and rel.is_next_to(block, other)
-        ]
-        return bool(neighbours) and all(
-            abs(after.pos(other)[1 - self.axis] - across) > LINE_TOL for other in neighbours
-        )
+        return not self.node.moved_ok(facts(before), facts(after), tuple(after.blocks), step.block, "any")
 
     def feasible(self, scene: Scene) -> bool:
         return len(scene.blocks) >= 2
@@ -171,7 +143,8 @@ class Align(_LineIntention):
         "Align all the blocks horizontally: one straight left-to-right row on the table, "
         "each block next to its neighbour, none stacked or in a bowl."
     )
-    axis = 0
+    node = Row(loaded=True)
+    axis = 0  # along x
     sides = ("right", "left")
 
 
@@ -181,7 +154,8 @@ class AlignVertical(_LineIntention):
         "Align all the blocks vertically: one straight front-to-back column on the table, "
         "each block next to its neighbour, none stacked or in a bowl."
     )
-    axis = 1
+    node = Column(loaded=True)
+    axis = 1  # along y
     sides = ("behind", "front")
 
 
@@ -189,26 +163,23 @@ class Stack(Intention):
     name = "stack"
     description = "Stack all the blocks into a single tower."
 
-    # A tower stands on the table: blocks piled in a bowl are in the bowl, not a tower
-    # (placement.standing_towers).
+    # A tower stands on the table: blocks piled in a bowl are in the bowl, not a tower. Building
+    # it only ever puts blocks on blocks of a standing tower; anything else (the table, a bowl, a
+    # pile in a bowl) is a wasted move (onto_standing).
+    node = Tower(onto_standing=True)
 
     def satisfied(self, state: WorldState) -> bool:
-        ts = standing_towers(state, relations(state))
-        return len(ts) == 1 and len(ts[0]) == len(state.blocks) > 0
+        return bool(state.blocks) and self.node.holds(facts(state), tuple(state.blocks), "any")
 
     def score(self, state: WorldState) -> float:
-        n = len(state.blocks)
-        return max((len(t) for t in standing_towers(state, relations(state))), default=0) / n if n else 0.0
+        return self.node.score(facts(state), tuple(state.blocks), "any") if state.blocks else 0.0
 
     def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
         if self.score(after) < self.score(before) - 1e-9:
             return True
-        # Building a tower only ever puts blocks on blocks of a tower standing on the table;
-        # anything else (the table, a bowl, a pile in a bowl) is a wasted move.
         if step.block not in after.blocks:
             return False
-        rel = relations(after)
-        return rel.below(step.block) is None or not any(step.block in t for t in standing_towers(after, rel))
+        return not self.node.moved_ok(facts(before), facts(after), tuple(after.blocks), step.block, "any")
 
     def feasible(self, scene: Scene) -> bool:
         return len(scene.blocks) >= 2
@@ -249,36 +220,26 @@ class TwoTowers(Intention):
     name = "two-towers"
     description = "Stack the blocks into two towers of (nearly) equal height."
 
-    # Towers stand on the table; blocks piled in a bowl are not a tower (see Stack).
+    # Towers stand on the table; blocks piled in a bowl are not a tower (see Stack). A move onto
+    # a tower already as tall as the taller wanted one goes against it (onto_standing).
+    node = TwoTowersNode(onto_standing=True)
 
     @staticmethod
     def heights(n: int) -> tuple[int, int]:
         return (n + 1) // 2, n // 2
 
     def satisfied(self, state: WorldState) -> bool:
-        n = len(state.blocks)
-        ts = standing_towers(state, relations(state))
-        return n >= 2 and len(ts) == 2 and (len(ts[0]), len(ts[1])) == self.heights(n)
+        return len(state.blocks) >= 2 and self.node.holds(facts(state), tuple(state.blocks), "")
 
     def score(self, state: WorldState) -> float:
-        n = len(state.blocks)
-        if not n:
-            return 0.0
-        ts = standing_towers(state, relations(state))
-        h1, h2 = self.heights(n)
-        got = (min(len(ts[0]), h1) if ts else 0) + (min(len(ts[1]), h2) if len(ts) > 1 else 0)
-        return got / n
+        return self.node.score(facts(state), tuple(state.blocks), "") if state.blocks else 0.0
 
     def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
         if self.score(after) < self.score(before) - 1e-9:
             return True
         if step.block not in after.blocks:
             return False
-        rel = relations(after)
-        if rel.below(step.block) is None:
-            return True
-        tower = next((t for t in standing_towers(after, rel) if step.block in t), None)
-        return tower is None or len(tower) > self.heights(len(after.blocks))[0]
+        return not self.node.moved_ok(facts(before), facts(after), tuple(after.blocks), step.block, "")
 
     def feasible(self, scene: Scene) -> bool:
         return len(scene.blocks) >= 4
@@ -331,29 +292,28 @@ class WarmInBowlsCoolStacked(BlockwiseIntention):
         "tower on the table."
     )
 
-    @staticmethod
-    def cool_tower(state: WorldState, rel: Relations) -> list[str]:
+    classes = ColourClass()
+    in_bowl = InBowl()
+    stacked = BottomOfTower()  # warm blocks put in bowls may stand on the cool tower
+
+    @classmethod
+    def cool_blocks(cls, f: Facts) -> tuple[str, ...]:
+        return tuple(b for b in f.blocks if cls.classes.pick(b, f.bowls, "cool"))
+
+    @classmethod
+    def cool_tower(cls, state: WorldState, rel: Relations) -> list[str]:
         """The longest run of cool blocks from the base of a tower standing on the table."""
-        best: list[str] = []
-        for tower in towers(state, rel):
-            if not on_table(rel, tower[0]):
-                continue
-            run = []
-            for b in tower:
-                if is_warm(b):
-                    break
-                run.append(b)
-            if len(run) > len(best):
-                best = run
-        return best
+        f = facts(state)
+        return cls.stacked.run(f, cls.cool_blocks(f))
 
     def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        if is_warm(block):
-            return rel.in_bowl(block) is not None
-        return block in self.cool_tower(state, rel)
+        f = facts(state)
+        if self.classes.pick(block, f.bowls, "warm"):
+            return self.in_bowl.ok(f, block, "any")
+        return block in self.stacked.run(f, self.cool_blocks(f))
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
-        if is_warm(block):
+        if self.classes.pick(block, tuple(state.bowls), "warm"):
             if not state.bowls:
                 return None
             here = state.pos(block)[:2]
@@ -365,8 +325,8 @@ class WarmInBowlsCoolStacked(BlockwiseIntention):
         return PutOn(block=block, target=tower[-1])
 
     def feasible(self, scene: Scene) -> bool:
-        warm = [b for b in scene.blocks if is_warm(b)]
-        cool = [b for b in scene.blocks if not is_warm(b)]
+        warm = [b for b in scene.blocks if self.classes.pick(b, tuple(scene.bowls), "warm")]
+        cool = [b for b in scene.blocks if not self.classes.pick(b, tuple(scene.bowls), "warm")]
         return bool(warm) and bool(cool) and bool(scene.bowls)
 
     def sample_scene(self, rng: np.random.Generator) -> Scene:

@@ -1,12 +1,19 @@
 """Intentions about blocks and bowls: colour match / mismatch (paper), one bowl, one block
-per bowl, next to the same-colour bowl."""
+per bowl, next to the same-colour bowl.
+
+Where a block is wanted is the goal language's (activeintent.goals): InBowl, SeparateBowls,
+OneBowl, OnTable and NextTo; scenes and the placing of blocks are the protocol's.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
+from activeintent.goals.facts import facts
+from activeintent.goals.language import InBowl, NextTo, OnTable, SeparateBowls
+from activeintent.goals.language import OneBowl as OneBowlNode
 from activeintent.intentions.blockwise import BlockwiseIntention
-from activeintent.intentions.placement import free_spot, on_table
+from activeintent.intentions.placement import free_spot
 from activeintent.world import (
     COLOR_NAMES,
     PutIn,
@@ -38,8 +45,10 @@ class ColorMatch(BlockwiseIntention):
     name = "color-match"
     description = "Put each block in the bowl of the same colour."
 
+    in_bowl = InBowl()
+
     def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        return rel.in_bowl(block) == _own_bowl(block)
+        return self.in_bowl.ok(facts(state), block, "same")
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
         return PutIn(block=block, bowl=_own_bowl(block)) if _own_bowl(block) in state.positions else None
@@ -57,9 +66,10 @@ class ColorMismatch(BlockwiseIntention):
     name = "color-mismatch"
     description = "Put each block in a bowl of a different colour from the block."
 
+    in_bowl = InBowl()
+
     def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        bowl = rel.in_bowl(block)
-        return bowl is not None and color_of(bowl) != color_of(block)
+        return self.in_bowl.ok(facts(state), block, "other")
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
         options = [w for w in state.bowls if color_of(w) != color_of(block)]
@@ -86,35 +96,29 @@ class ColorMismatch(BlockwiseIntention):
         return Scene(objects=[f"{c} block" for c in blocks] + [f"{c} bowl" for c in bowls])
 
 
-def _majority_bowl(state: WorldState, rel: Relations) -> str | None:
-    """The bowl holding the most blocks (ties: first in the state), None without bowls."""
-    if not state.bowls:
-        return None
-    return max(state.bowls, key=lambda w: (len(_blocks_in(rel, w)), -state.bowls.index(w)))
-
-
 class OneBowl(BlockwiseIntention):
     name = "one-bowl"
     description = "Put all the blocks together in one bowl (any bowl)."
 
+    # Blocks go to the fullest bowl; starting a second bowl while another one already holds
+    # blocks moves away (into_used).
+    node = OneBowlNode(into_used=True)
+
+    def target(self, state: WorldState) -> str | None:
+        return self.node.fullest(facts(state), tuple(state.blocks))
+
     def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        target = _majority_bowl(state, rel)
-        return target is not None and rel.in_bowl(block) == target
+        target = self.target(state)
+        return target is not None and facts(state).bowl_of[block] == target
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
-        target = _majority_bowl(state, rel)
+        target = self.target(state)
         return PutIn(block=block, bowl=target) if target else None
 
     def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
         if self.score(after) < self.score(before) - 1e-9:
             return True
-        rel_b, rel_a = relations(before), relations(after)
-        bowl = rel_a.in_bowl(step.block)
-        if bowl is None:
-            return True
-        # Starting a second bowl while another one already holds blocks moves away.
-        used = {w for a, w in rel_b.inside if a != step.block}
-        return bool(used) and bowl not in used
+        return not self.node.moved_ok(facts(before), facts(after), tuple(after.blocks), step.block, "")
 
     def feasible(self, scene: Scene) -> bool:
         return len(scene.blocks) >= 2 and len(scene.bowls) >= 1
@@ -132,9 +136,11 @@ class OneBlockPerBowl(BlockwiseIntention):
     name = "one-block-per-bowl"
     description = "Put each block alone in its own bowl, whatever the colours."
 
+    alone = SeparateBowls()
+
     def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        bowl = rel.in_bowl(block)
-        return bowl is not None and _blocks_in(rel, bowl) == [block]
+        f = facts(state)
+        return self.alone.block_ok(f, f.blocks, block)
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
         empty = [w for w in state.bowls if not _blocks_in(rel, w)]
@@ -158,9 +164,12 @@ class NextToSameColorBowl(BlockwiseIntention):
     name = "next-to-same-color-bowl"
     description = "Put each block on the table next to (not in) the bowl of its own colour."
 
+    on_table = OnTable()
+    next_to = NextTo()
+
     def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        bowl = _own_bowl(block)
-        return bowl in state.positions and on_table(rel, block) and rel.is_next_to(block, bowl)
+        f = facts(state)
+        return self.on_table.ok(f, block, "") and self.next_to.ok(f, block, "own-bowl")
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
         bowl = _own_bowl(block)

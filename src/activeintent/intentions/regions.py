@@ -2,21 +2,19 @@
 
 Table regions follow world.relations.table_position_name (a 3 × 3 grid of 20 cm cells);
 halves split the table at x = 0 (left → right is −x → +x).
+
+Where a block is wanted is the goal language's (activeintent.goals): Corners and InRegion's
+halves, warm / cool by ColourClass; scenes and the placing of blocks are the protocol's.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from activeintent.goals.facts import facts
+from activeintent.goals.language import CORNER_CELL, ColourClass, Corners, InRegion
 from activeintent.intentions.blockwise import BlockwiseIntention
-from activeintent.intentions.placement import (
-    TABLE_INNER,
-    free_spot,
-    grid,
-    is_warm,
-    nearest_first,
-    on_table,
-)
+from activeintent.intentions.placement import TABLE_INNER, free_spot, grid, nearest_first
 from activeintent.world import (
     COOL_COLORS,
     WARM_COLORS,
@@ -52,25 +50,26 @@ class BlocksInCorners(BlockwiseIntention):
     name = "blocks-in-corners"
     description = "Put each block on the table in a different corner of the table."
 
-    @staticmethod
-    def corner(rel: Relations, block: str) -> str | None:
-        where = rel.table_position.get(block)
-        return where if on_table(rel, block) and where in CORNERS else None
+    corners = Corners()
+
+    @classmethod
+    def corner(cls, state: WorldState, block: str) -> str | None:
+        """The corner cell (world.relations' name) ``block`` stands in on the table, if any."""
+        return CORNER_CELL.get(cls.corners.corner(facts(state), block))
 
     def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        mine = self.corner(rel, block)
-        return mine is not None and all(self.corner(rel, b) != mine for b in state.blocks if b != block)
+        f = facts(state)
+        return self.corners.block_ok(f, f.blocks, block)
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
         # Corners already held by another block (wanted or not) are taken.
-        taken = {self.corner(rel, b) for b in state.blocks if b != block}
+        taken = {self.corner(state, b) for b in state.blocks if b != block}
         here = state.pos(block)[:2]
         free = [c for c in CORNERS if c not in taken]
         for corner in nearest_first_named(free, here):
 
             def ok(after: WorldState, corner: str = corner) -> bool:
-                r = relations(after)
-                return self.corner(r, block) == corner
+                return self.corner(after, block) == corner
 
             spots: list = [corner, *nearest_first(grid(*_cell(corner), step=0.035), np.array(TABLE_POSITIONS[corner]))]
             if step := free_spot(state, block, spots, accept=ok):
@@ -92,12 +91,13 @@ def nearest_first_named(names: list[str], to: np.ndarray) -> list[str]:
 class _HalfIntention(BlockwiseIntention):
     """Blocks on the table, each in the half of the table chosen by ``side``."""
 
+    region = InRegion()
+
     def side(self, block: str) -> str:
         raise NotImplementedError
 
     def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        x = state.pos(block)[0]
-        return on_table(rel, block) and (x < 0 if self.side(block) == "left" else x > 0)
+        return self.region.ok(facts(state), block, f"{self.side(block)} half")
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
         (x0, x1), ys = TABLE_INNER
@@ -137,11 +137,16 @@ class WarmLeftCoolRight(_HalfIntention):
         "right half."
     )
 
+    classes = ColourClass()
+
+    def is_warm(self, block: str) -> bool:
+        return self.classes.pick(block, (), "warm")
+
     def side(self, block: str) -> str:
-        return "left" if is_warm(block) else "right"
+        return "left" if self.is_warm(block) else "right"
 
     def feasible(self, scene: Scene) -> bool:
-        return any(is_warm(b) for b in scene.blocks) and any(not is_warm(b) for b in scene.blocks)
+        return any(self.is_warm(b) for b in scene.blocks) and any(not self.is_warm(b) for b in scene.blocks)
 
     def sample_scene(self, rng: np.random.Generator) -> Scene:
         warm = [str(c) for c in rng.choice(sorted(WARM_COLORS), size=1 + int(rng.integers(0, 2)), replace=False)]

@@ -44,9 +44,9 @@ from itertools import combinations, permutations
 
 import numpy as np
 
-from activeintent.intentions.arrangements import Align
 from activeintent.intentions.base import Intention
 from activeintent.intentions.blockwise import BlockwiseIntention
+from activeintent.intentions.lines import StraightLine as Align
 from activeintent.intentions.placement import (
     LINE_TOL,
     ROW_PITCH,
