@@ -36,7 +36,7 @@ import numpy as np
 from activeintent.goals.facts import ALIGN_TOL, Facts, facts
 from activeintent.goals.planning import GRID, area_points
 from activeintent.registry import Registry
-from activeintent.world import BLOCK_SIZE, PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState
+from activeintent.world import BLOCK_SIZE, BOUNDS, PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState
 from activeintent.world.colors import COLOR_NAMES, COOL_COLORS, WARM_COLORS
 from activeintent.world.relations import table_position_name
 from activeintent.world.scene import ALL_OBJECTS, color_of, footprint_radius, kind_of
@@ -561,10 +561,15 @@ ORDER_WORDS = {"rainbow": "in rainbow order", "warm-first": "the warm-coloured o
                "cool-first": "the cool-coloured ones first"}
 
 
+# An order outside ORDERS (not in the language): the rainbow from red to purple, where a block of
+# pink, brown or gray has no place (the dev suite's rainbow row).
+RED_TO_PURPLE = "red-to-purple"
+
+
 def _order_key(order: str):
     """Sort key of an order: the rainbow rank, or the colour class (then the rainbow rank, so
     that a plan has one target; any arrangement with the classes in order satisfies it)."""
-    if order == "rainbow":
+    if order in ("rainbow", RED_TO_PURPLE):
         return _rank
     first = "warm" if order == "warm-first" else "cool"
     return lambda b: (_class(b) != first, _rank(b))
@@ -576,6 +581,8 @@ def in_order(seq, order: str) -> bool:
         return True
     if order == "rainbow":
         return list(seq) == sorted(seq, key=_rank)
+    if order == RED_TO_PURPLE:
+        return all(color_of(b) in RAINBOW[:7] for b in seq) and list(seq) == sorted(seq, key=_rank)
     first = "warm" if order == "warm-first" else "cool"
     ks = [_class(b) != first for b in seq]
     return ks == sorted(ks)
@@ -590,14 +597,19 @@ class Line(Structure):
     sides = ("right", "left")
     words = ("one left-to-right row", "left to right")
 
-    def __init__(self, min_size: int | None = None, beside_any: bool = False, loaded: bool = False):
+    def __init__(self, min_size: int | None = None, beside_any: bool = False, loaded: bool = False,
+                 order_beside: bool = False):
         """``beside_any``: a moved block set beside any block, not only one of the group, must be
         in line with one of them (the bayes grammar's row and column). ``loaded``: a block of
         the line only has to rest on the table, another block may stand on it (the library's
-        align and align-vertical; by default the blocks of a line are flat, nothing on them)."""
+        align and align-vertical; by default the blocks of a line are flat, nothing on them).
+        ``order_beside``: a moved block may be set beside blocks out of line, but with every
+        block it is in line beside it must make a line in the order (the dev suite's rainbow
+        row; by default it must be in line with one of its neighbours, whatever the order)."""
         super().__init__(min_size)
         self.beside_any = beside_any
         self.loaded = loaded
+        self.order_beside = order_beside
 
     def member(self, f: Facts, b: str) -> bool:
         """Can ``b`` be part of a line where it stands?"""
@@ -638,6 +650,8 @@ class Line(Structure):
             return False
         v = fa.xy[b][self.axis]
         near = [o for o in (fa.blocks if self.beside_any else g) if o != b and self.member(fa, o) and fa.next_to(b, o)]
+        if self.order_beside:
+            return all(self.line(fa, (b, o), p) for o in near if abs(fa.xy[o][self.axis] - v) <= ALIGN_TOL)
         return not near or any(abs(fa.xy[o][self.axis] - v) <= ALIGN_TOL for o in near)
 
     def suggest(self, state, g, p):
@@ -669,6 +683,45 @@ class Column(Line):
     axis = 0
     sides = ("behind", "front")
     words = ("one front-to-back column", "front to back")
+
+
+# The left edge with its border in: centres at most EDGE from the table's left edge (Placed's
+# "left-edge" leaves the border out).
+def along_left_edge(xy) -> bool:
+    return float(xy[0]) <= BOUNDS[0][0] + EDGE + 1e-9
+
+
+class LineWithin(Structure):
+    """A line (``line``: a Row or Column) of blocks all inside an ``area`` of the table, scored by
+    the longest such line inside the area; a moved block must rest in the area (the line's rule
+    on neighbours is not asked). Not registered (see InCell): Placed(Column) at the left edge
+    scores the mean of the shape and the share in place. The dev suite's column along the left
+    edge."""
+
+    def __init__(self, line: Line, area, area_key: str, area_words: str):
+        self.line = line
+        self.area = area
+        self.key = f"{line.key}-within-{area_key}"
+        self.params = line.params
+        self.area_words = area_words
+
+    def sentence(self, subject, p):
+        return f"{self.line.sentence(subject, p)}, {self.area_words}"
+
+    def inside(self, f: Facts, g: Group) -> Group:
+        return tuple(b for b in g if self.area(f.xy[b]))
+
+    def holds(self, f, g, p):
+        return len(self.inside(f, g)) == len(g) and self.line.line(f, g, p)
+
+    def score(self, f, g, p):
+        return len(self.line.best(f, self.inside(f, g), p)) / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        return self.line.member(fa, b) and bool(self.area(fa.xy[b]))
+
+    def suggest(self, state, g, p):
+        return self.line.suggest(state, g, p)
 
 
 def _towers(f: Facts, g: Group, on_table: bool = True) -> list[list[str]]:
@@ -748,6 +801,34 @@ class Tower(Structure):
         for tower in t[:2]:
             out += [PutOn(block=b, target=tower[-1]) for b in g if b not in tower]
         return out
+
+
+class TowerByBowl(Tower):
+    """One tower of the group standing on the table with its bottom block right next to a bowl
+    (any bowl); scored by the tallest such tower; a moved block must end in one (a lone block
+    by a bowl is a tower of one). Not registered (see InCell): Placed(Tower) "by-a-bowl" scores
+    the mean of the shape and the share in place. The dev suite's tower beside a bowl."""
+
+    key = "tower-by-bowl"
+    params = ("any",)
+
+    def sentence(self, subject, p):
+        return f"{subject} are stacked into one tower standing on the table right next to a bowl"
+
+    def by_bowl(self, f: Facts, g: Group) -> list[list[str]]:
+        return [t for t in _towers(f, g) if any(f.next_to(t[0], w) for w in f.bowls)]
+
+    def holds(self, f, g, p):
+        return any(len(t) == len(g) for t in self.by_bowl(f, g))
+
+    def score(self, f, g, p):
+        return max((len(t) for t in self.by_bowl(f, g)), default=0) / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        return any(b in t for t in self.by_bowl(fa, g))
+
+    def possible(self, g, objects, p):
+        return len(g) >= self.min_size and any(kind_of(o) == "bowl" for o in objects)
 
 
 class TowersByClass(Structure):
@@ -969,11 +1050,21 @@ class SeparateBowls(Structure):
     key = "separate-bowls"
     min_size = 1
 
+    def __init__(self, min_size: int | None = None, at_most: int = 1):
+        """``at_most``: blocks of the group a bowl may hold (the dev suite's at most two per bowl;
+        by default one block per bowl)."""
+        super().__init__(min_size)
+        self.at_most = at_most
+
     def sentence(self, subject, p):
+        if self.at_most != 1:
+            return f"{subject} go in bowls, at most {NUMBER.get(str(self.at_most), self.at_most)} blocks per bowl"
         return f"{subject} go in bowls, one block per bowl"
 
     def block_ok(self, f, g, b):
         w = f.bowl_of[b]
+        if self.at_most != 1:
+            return w is not None and sum(f.bowl_of[o] == w for o in g) <= self.at_most
         return w is not None and not any(o != b and f.bowl_of[o] == w for o in g)
 
     def holds(self, f, g, p):
@@ -986,7 +1077,7 @@ class SeparateBowls(Structure):
         return self.block_ok(fa, g, b)
 
     def possible(self, g, objects, p):
-        return 1 <= len(g) <= sum(kind_of(o) == "bowl" for o in objects)
+        return 1 <= len(g) <= self.at_most * sum(kind_of(o) == "bowl" for o in objects)
 
     def suggest(self, state, g, p):
         f = facts(state)
@@ -997,11 +1088,17 @@ class SeparateBowls(Structure):
 class Cluster(Structure):
     key = "cluster"
 
-    def __init__(self, min_size: int | None = None, touching: bool = False):
+    def __init__(self, min_size: int | None = None, touching: bool = False, loaded: bool = False):
         """``touching``: a moved block must end next to another flat block of the group, unless
-        the group is that one block (the bayes grammar's cluster)."""
+        the group is that one block (the bayes grammar's cluster). ``loaded``: a block of the
+        group only has to rest on the table, another may stand on it (the dev suite's blocks
+        together; by default the blocks are flat, nothing on them)."""
         super().__init__(min_size)
         self.touching = touching
+        self.loaded = loaded
+
+    def member(self, f: Facts, b: str) -> bool:
+        return _rests_on_table(f, b) if self.loaded else _flat(f, b)
 
     def sentence(self, subject, p):
         return f"{subject} are grouped together on the table, each touching another"
@@ -1011,25 +1108,25 @@ class Cluster(Structure):
         while todo:
             a = todo.pop()
             for o in g:
-                if o not in seen and _flat(f, o) and f.next_to(a, o):
+                if o not in seen and self.member(f, o) and f.next_to(a, o):
                     seen.add(o)
                     todo.append(o)
         return seen
 
     def holds(self, f, g, p):
-        return all(_flat(f, b) for b in g) and len(self._comp(f, g, g[0])) == len(g)
+        return all(self.member(f, b) for b in g) and len(self._comp(f, g, g[0])) == len(g)
 
     def score(self, f, g, p):
-        return max((len(self._comp(f, g, b)) for b in g if _flat(f, b)), default=0) / len(g)
+        return max((len(self._comp(f, g, b)) for b in g if self.member(f, b)), default=0) / len(g)
 
     def moved_ok(self, fb, fa, g, b, p):
         if not self.touching:
-            return _flat(fa, b)
-        return _flat(fa, b) and (len(g) == 1 or any(o != b and _flat(fa, o) and fa.next_to(b, o) for o in g))
+            return self.member(fa, b)
+        return self.member(fa, b) and (len(g) == 1 or any(o != b and self.member(fa, o) and fa.next_to(b, o) for o in g))
 
     def suggest(self, state, g, p):
         f = facts(state)
-        flat = [b for b in g if _flat(f, b)]
+        flat = [b for b in g if self.member(f, b)]
         if not flat:
             return []
         core = max((self._comp(f, g, b) for b in flat), key=len)
@@ -1078,6 +1175,32 @@ class Corners(Structure):
                     if c not in taken:
                         out += free_points(state, region_points(c), b, 3)
         return out
+
+
+class SameCorner(Structure):
+    """The whole group in one and the same corner cell of the table, any corner, blocks stacked
+    or in a bowl there included; scored by the fullest corner; a moved block must end in a
+    fullest corner. Not registered (see InCell): Placed(Cluster) "a-corner" also wants a group
+    flat on the table and touching. The dev suite's gathering in one corner."""
+
+    key = "same-corner"
+    min_size = 1
+
+    def sentence(self, subject, p):
+        return f"{subject} all go in one corner of the table"
+
+    def counts(self, f: Facts, g: Group) -> dict[str, int]:
+        return {c: sum(f.cell[b] == c for b in g) for c in CORNER_CELL.values()}
+
+    def holds(self, f, g, p):
+        return max(self.counts(f, g).values()) == len(g)
+
+    def score(self, f, g, p):
+        return max(self.counts(f, g).values()) / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        c = self.counts(fa, g)
+        return c.get(fa.cell[b], 0) >= max(c.values())
 
 
 class EachBowl(Structure):
@@ -1129,11 +1252,31 @@ class AroundBowl(Structure):
     key = "around-bowl"
     min_size = 1
 
+    def __init__(self, min_size: int | None = None, loaded: bool = False):
+        """``loaded``: a block around the bowl only has to rest on the table, another may stand
+        on it (the dev suite's blocks around a bowl; by default flat, nothing on it)."""
+        super().__init__(min_size)
+        self.loaded = loaded
+
     def sentence(self, subject, p):
         return f"{subject} stand on the table around one bowl, each right next to it"
 
+    def member(self, f: Facts, b: str) -> bool:
+        return _rests_on_table(f, b) if self.loaded else f.flat(b)
+
     def _best(self, f, g):
-        return max(((sum(f.flat(b) and f.next_to(b, w) for b in g), w) for w in f.bowls), default=(0, None))
+        return max(((sum(self.member(f, b) and f.next_to(b, w) for b in g), w) for w in f.bowls), default=(0, None))
+
+    def target(self, f: Facts, g: Group) -> str | None:
+        """The bowl with the most blocks of the group around it (ties: the first in the state),
+        None without bowls."""
+        return max(f.bowls, key=lambda w: (sum(self.member(f, b) and f.next_to(b, w) for b in g), -f.bowls.index(w)),
+                   default=None)
+
+    def block_ok(self, f: Facts, g: Group, b: str) -> bool:
+        """Is ``b`` around the bowl the group gathers at?"""
+        w = self.target(f, g)
+        return w is not None and self.member(f, b) and f.next_to(b, w)
 
     def holds(self, f, g, p):
         return self._best(f, g)[0] == len(g)
@@ -1142,7 +1285,7 @@ class AroundBowl(Structure):
         return self._best(f, g)[0] / len(g)
 
     def moved_ok(self, fb, fa, g, b, p):
-        return fa.flat(b) and any(fa.next_to(b, w) for w in fa.bowls)
+        return self.member(fa, b) and any(fa.next_to(b, w) for w in fa.bowls)
 
     def possible(self, g, objects, p):
         return any(kind_of(o) == "bowl" for o in objects) and len(g) <= 4
@@ -1186,6 +1329,60 @@ class GroupsByClass(Structure):
 
     def suggest(self, state, g, p):
         return [s for part in TowersByClass.parts(g) for s in Cluster().suggest(state, part, "")]
+
+
+class ClassGroupsApart(Structure):
+    """The warm-coloured blocks of the group together and the cool-coloured ones together on the
+    table, a block touching one of the other class counting for neither; scored by the largest
+    group of each class. A moved block must rest apart from the other class and next to a block
+    of its own (when it has one). Not registered (see InCell): GroupsByClass wants flat blocks
+    and scores a penalty per touching pair. The dev suite's warm and cool groups."""
+
+    key = "class-groups-apart"
+    min_size = 3
+
+    def sentence(self, subject, p):
+        return (f"{subject} form two groups on the table, the warm-coloured ones together and the "
+                "cool-coloured ones together, none touching one of the other kind")
+
+    @staticmethod
+    def apart(f: Facts, g: Group, b: str) -> bool:
+        """On the table (another block may stand on it), touching no block of the other class."""
+        return _rests_on_table(f, b) and not any(f.next_to(b, o) for o in g if _class(o) != _class(b))
+
+    def largest(self, f: Facts, g: Group, part: Group) -> int:
+        left = [b for b in part if self.apart(f, g, b)]
+        best = 0
+        while left:
+            group, todo = {left[0]}, [left[0]]
+            while todo:
+                a = todo.pop()
+                for o in left:
+                    if o not in group and f.next_to(a, o):
+                        group.add(o)
+                        todo.append(o)
+            left = [b for b in left if b not in group]
+            best = max(best, len(group))
+        return best
+
+    def placed(self, f: Facts, g: Group) -> int:
+        return sum(self.largest(f, g, part) for part in TowersByClass.parts(g))
+
+    def holds(self, f, g, p):
+        return self.placed(f, g) == len(g)
+
+    def score(self, f, g, p):
+        return self.placed(f, g) / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        kin = [o for o in g if o != b and _class(o) == _class(b)]
+        return self.apart(fa, g, b) and (not kin or any(fa.next_to(b, o) for o in kin))
+
+    def possible(self, g, objects, p):
+        return len(TowersByClass.parts(g)) == 2 and len(g) >= 3
+
+    def suggest(self, state, g, p):
+        return GroupsByClass().suggest(state, g, p)
 
 
 PLACES = ("back-edge", "front-edge", "left-edge", "right-edge", "middle", "a-corner", "by-a-bowl")
