@@ -9,16 +9,37 @@ Conventions follow the built-in library: "front" is the bottom side of the table
 side a block goes to with "in front of"), "left" is −x, warm / cool colours are
 world.WARM_COLORS / COOL_COLORS, and every plan is checked with the symbolic world model
 before it is returned.
+
+What each intention means (what a state must satisfy, its score, which moves go against it) is
+the goal language's (activeintent.goals): a node over all the blocks, with the options or the
+unregistered node that say the intention's own reading. Scenes and oracle plans are the
+protocol's and stay here.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator
-from itertools import combinations
 
 import numpy as np
 
-from activeintent.intentions.arrangements import Align, AlignVertical
+from activeintent.goals.facts import facts
+from activeintent.goals.language import (
+    RED_TO_PURPLE,
+    AroundBowl,
+    ClassGroupsApart,
+    Cluster,
+    ColourClass,
+    Column,
+    InBowl,
+    LineWithin,
+    OnBlock,
+    Row,
+    SameCorner,
+    SeparateBowls,
+    TowerByBowl,
+    along_left_edge,
+    in_order,
+)
 from activeintent.intentions.base import Intention
 from activeintent.intentions.blockwise import BlockwiseIntention
 from activeintent.intentions.placement import (
@@ -228,46 +249,30 @@ class RainbowRow(Intention):
         "Line the blocks up in one left-to-right row in rainbow order (red, orange, yellow, "
         "green, cyan, blue, purple)."
     )
-    _row = Align()
+    # A row of blocks resting on the table (loaded) in the order red to purple; a block set in
+    # line beside one it should not be on that side of moves away (order_beside).
+    node = Row(beside_any=True, loaded=True, order_beside=True)
 
     def ordered_row(self, state: WorldState, rel: Relations, members: Iterable[str]) -> bool:
-        members = list(members)
-        if not self._row.line_ok(state, rel, members):
-            return False
-        ranks = [_rank(b) for b in sorted(members, key=lambda b: state.pos(b)[0])]
-        return None not in ranks and ranks == sorted(ranks)  # type: ignore[type-var]
+        return self.node.line(facts(state), tuple(members), RED_TO_PURPLE)
 
     def satisfied(self, state: WorldState) -> bool:
-        return len(state.blocks) >= 2 and self.ordered_row(state, relations(state), state.blocks)
+        return len(state.blocks) >= 2 and self.node.holds(facts(state), tuple(state.blocks), RED_TO_PURPLE)
 
     def score(self, state: WorldState) -> float:
         n = len(state.blocks)
         if not n:
             return 0.0
-        rel = relations(state)
-        flat = [b for b in state.blocks if on_table(rel, b) and _rank(b) is not None]
-        for size in range(len(flat), 1, -1):
-            if any(self.ordered_row(state, rel, c) for c in combinations(flat, size)):
-                return size / n
-        return (1 if flat else 0) / n
+        f = facts(state)
+        placeable = tuple(b for b in f.blocks if in_order((b,), RED_TO_PURPLE))  # pink, brown, gray never count
+        return len(self.node.best(f, placeable, RED_TO_PURPLE)) / n
 
     def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
         if self.score(after) < self.score(before) - 1e-9:
             return True
-        rel, block = relations(after), step.block
-        if block not in after.blocks:
+        if step.block not in after.blocks:
             return False
-        if not on_table(rel, block):
-            return True
-        # Set in line beside a block it should not be on that side of.
-        for other in after.blocks:
-            if other == block or not on_table(rel, other) or not rel.is_next_to(block, other):
-                continue
-            if abs(after.pos(other)[1] - after.pos(block)[1]) > 0.02:
-                continue
-            if not self.ordered_row(after, rel, [block, other]):
-                return True
-        return False
+        return not self.node.moved_ok(facts(before), facts(after), tuple(after.blocks), step.block, RED_TO_PURPLE)
 
     def feasible(self, scene: Scene) -> bool:
         return len(scene.blocks) >= 2 and all(_rank(b) is not None for b in scene.blocks)
@@ -308,26 +313,24 @@ class OneCorner(Intention):
     name = "dev-gather-in-one-corner"
     description = "Gather all the blocks together in one corner of the table, whichever corner you like."
 
-    @staticmethod
-    def counts(state: WorldState, rel: Relations) -> dict[str, int]:
-        return {c: sum(rel.table_position[b] == c for b in state.blocks) for c in CORNERS}
+    node = SameCorner()
+
+    @classmethod
+    def counts(cls, state: WorldState, rel: Relations) -> dict[str, int]:
+        return cls.node.counts(facts(state), tuple(state.blocks))
 
     def satisfied(self, state: WorldState) -> bool:
-        n = len(state.blocks)
-        return n >= 1 and max(self.counts(state, relations(state)).values()) == n
+        return len(state.blocks) >= 1 and self.node.holds(facts(state), tuple(state.blocks), "")
 
     def score(self, state: WorldState) -> float:
-        n = len(state.blocks)
-        return max(self.counts(state, relations(state)).values()) / n if n else 0.0
+        return self.node.score(facts(state), tuple(state.blocks), "") if state.blocks else 0.0
 
     def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
         if self.score(after) < self.score(before) - 1e-9:
             return True
         if step.block not in after.blocks:
             return False
-        rel = relations(after)
-        counts = self.counts(after, rel)
-        return counts.get(rel.table_position[step.block], 0) < max(counts.values())
+        return not self.node.moved_ok(facts(before), facts(after), tuple(after.blocks), step.block, "")
 
     def feasible(self, scene: Scene) -> bool:
         return len(scene.blocks) >= 2
@@ -378,9 +381,11 @@ class AtMostTwoPerBowl(BlockwiseIntention):
     name = "dev-at-most-two-per-bowl"
     description = "Put every block in a bowl, with no more than two blocks in any one bowl."
 
+    node = SeparateBowls(at_most=2)
+
     def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        bowl = rel.in_bowl(block)
-        return bowl is not None and len(_blocks_in(rel, bowl)) <= 2
+        f = facts(state)
+        return self.node.block_ok(f, f.blocks, block)
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
         room = [w for w in state.bowls if len(_blocks_in(rel, w)) < 2 and rel.in_bowl(block) != w]
@@ -403,9 +408,10 @@ class SameWarmthBowls(BlockwiseIntention):
         "cool-coloured bowl."
     )
 
+    in_bowl = InBowl()
+
     def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        bowl = rel.in_bowl(block)
-        return bowl is not None and is_warm(bowl) == is_warm(block)
+        return self.in_bowl.ok(facts(state), block, "same-class")
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
         best = _emptiest_bowls(state, rel, block, [w for w in state.bowls if is_warm(w) == is_warm(block)])
@@ -431,11 +437,12 @@ class WarmOnCool(BlockwiseIntention):
     name = "dev-warm-on-cool"
     description = "Put each warm-coloured block on top of a cool-coloured block."
 
+    classes = ColourClass()
+    on_block = OnBlock()
+
     def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        if not is_warm(block):
-            return True
-        below = rel.below(block)
-        return below is not None and not is_warm(below)
+        f = facts(state)
+        return not self.classes.pick(block, f.bowls, "warm") or self.on_block.ok(f, block, "cool")
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
         cool = [b for b in state.blocks if not is_warm(b) and is_clear(rel, b)]
@@ -459,28 +466,27 @@ class BlocksTogether(Intention):
     name = "dev-blocks-together"
     description = "Gather all the blocks into one group on the table, each block right next to at least one other."
 
+    # Blocks resting on the table (loaded), a moved block next to another one (touching).
+    node = Cluster(touching=True, loaded=True)
+
     @staticmethod
     def groups(state: WorldState, rel: Relations) -> list[list[str]]:
         return _components(rel, [b for b in state.blocks if on_table(rel, b)])
 
     def satisfied(self, state: WorldState) -> bool:
-        groups = self.groups(state, relations(state))
-        return len(state.blocks) >= 2 and len(groups) == 1 and len(groups[0]) == len(state.blocks)
+        return len(state.blocks) >= 2 and self.node.holds(facts(state), tuple(state.blocks), "")
 
     def score(self, state: WorldState) -> float:
-        n = len(state.blocks)
-        groups = self.groups(state, relations(state))
-        return len(groups[0]) / n if n and groups else 0.0
+        return self.node.score(facts(state), tuple(state.blocks), "") if state.blocks else 0.0
 
     def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
         if self.score(after) < self.score(before) - 1e-9:
             return True
-        rel, block = relations(after), step.block
-        if block not in after.blocks:
+        if step.block not in after.blocks:
             return False
-        if not on_table(rel, block):
-            return True
-        return not any(rel.is_next_to(block, b) for b in after.blocks if b != block and on_table(rel, b))
+        # A lone block has no other to be next to (the node lets a group of one stand alone).
+        return len(after.blocks) == 1 or not self.node.moved_ok(
+            facts(before), facts(after), tuple(after.blocks), step.block, "")
 
     def feasible(self, scene: Scene) -> bool:
         return len(scene.blocks) >= 2
@@ -545,20 +551,16 @@ class AroundOneBowl(BlockwiseIntention):
     name = "dev-blocks-around-a-bowl"
     description = "Put all the blocks on the table around one bowl, each of them right next to that bowl."
 
-    @staticmethod
-    def target(state: WorldState, rel: Relations) -> str | None:
+    node = AroundBowl(loaded=True)  # blocks resting on the table, another may stand on one
+
+    @classmethod
+    def target(cls, state: WorldState, rel: Relations) -> str | None:
         """The bowl with the most blocks next to it (ties: the first listed)."""
-        if not state.bowls:
-            return None
-
-        def count(w: str) -> int:
-            return sum(on_table(rel, b) and rel.is_next_to(b, w) for b in state.blocks)
-
-        return max(state.bowls, key=lambda w: (count(w), -state.bowls.index(w)))
+        return cls.node.target(facts(state), tuple(state.blocks))
 
     def wanted(self, state: WorldState, rel: Relations, block: str) -> bool:
-        bowl = self.target(state, rel)
-        return bowl is not None and on_table(rel, block) and rel.is_next_to(block, bowl)
+        f = facts(state)
+        return self.node.block_ok(f, f.blocks, block)
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
         bowl = self.target(state, rel)
@@ -606,30 +608,24 @@ class TowerBesideBowl(Intention):
     name = "dev-tower-beside-a-bowl"
     description = "Stack all the blocks into one tower standing on the table right next to a bowl."
 
-    @staticmethod
-    def good(state: WorldState, rel: Relations, tower: list[str]) -> bool:
-        base = tower[0]
-        return on_table(rel, base) and any(rel.is_next_to(base, w) for w in state.bowls)
+    node = TowerByBowl()
+
+    @classmethod
+    def good(cls, state: WorldState, rel: Relations, tower: list[str]) -> bool:
+        return tower in cls.node.by_bowl(facts(state), tuple(state.blocks))
 
     def satisfied(self, state: WorldState) -> bool:
-        rel = relations(state)
-        ts = towers(state, rel)
-        return len(state.blocks) >= 2 and len(ts) == 1 and self.good(state, rel, ts[0])
+        return len(state.blocks) >= 2 and self.node.holds(facts(state), tuple(state.blocks), "any")
 
     def score(self, state: WorldState) -> float:
-        n = len(state.blocks)
-        if not n:
-            return 0.0
-        rel = relations(state)
-        return max((len(t) for t in towers(state, rel) if self.good(state, rel, t)), default=0) / n
+        return self.node.score(facts(state), tuple(state.blocks), "any") if state.blocks else 0.0
 
     def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
         if self.score(after) < self.score(before) - 1e-9:
             return True
         if step.block not in after.blocks:
             return False
-        rel = relations(after)
-        return not any(step.block in t and self.good(after, rel, t) for t in towers(after, rel))
+        return not self.node.moved_ok(facts(before), facts(after), tuple(after.blocks), step.block, "any")
 
     def feasible(self, scene: Scene) -> bool:
         return len(scene.blocks) >= 2 and len(scene.bowls) >= 1
@@ -677,44 +673,35 @@ class TowerBesideBowl(Intention):
 
 
 # "Along the left edge": block centres at most 10 cm from the table's left edge (x = -0.3), so
-# a column in the left third but nearer the middle of the table does not count.
+# a column in the left third but nearer the middle of the table does not count
+# (goals.language.along_left_edge).
 LEFT_EDGE_X = BOUNDS[0][0] + 0.10
 
 
 def _by_left_edge(state: WorldState, block: str) -> bool:
-    return float(state.pos(block)[0]) <= LEFT_EDGE_X + 1e-9
+    return along_left_edge(state.pos(block))
 
 
 class LeftEdgeColumn(Intention):
     name = "dev-column-along-left-edge"
     description = "Line the blocks up front to back in one straight column along the left edge of the table."
-    _column = AlignVertical()
+    node = LineWithin(Column(loaded=True), along_left_edge, "left-edge", "along the left edge of the table")
 
     def column_ok(self, state: WorldState, rel: Relations, members: Iterable[str]) -> bool:
-        members = list(members)
-        return all(_by_left_edge(state, b) for b in members) and self._column.line_ok(state, rel, members)
+        return self.node.holds(facts(state), tuple(members), "any")
 
     def satisfied(self, state: WorldState) -> bool:
-        return len(state.blocks) >= 2 and self.column_ok(state, relations(state), state.blocks)
+        return len(state.blocks) >= 2 and self.node.holds(facts(state), tuple(state.blocks), "any")
 
     def score(self, state: WorldState) -> float:
-        n = len(state.blocks)
-        if not n:
-            return 0.0
-        rel = relations(state)
-        flat = [b for b in state.blocks if on_table(rel, b) and _by_left_edge(state, b)]
-        for size in range(len(flat), 1, -1):
-            if any(self.column_ok(state, rel, c) for c in combinations(flat, size)):
-                return size / n
-        return (1 if flat else 0) / n
+        return self.node.score(facts(state), tuple(state.blocks), "any") if state.blocks else 0.0
 
     def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
         if self.score(after) < self.score(before) - 1e-9:
             return True
         if step.block not in after.blocks:
             return False
-        rel = relations(after)
-        return not on_table(rel, step.block) or not _by_left_edge(after, step.block)
+        return not self.node.moved_ok(facts(before), facts(after), tuple(after.blocks), step.block, "any")
 
     def feasible(self, scene: Scene) -> bool:
         return 2 <= len(scene.blocks) <= 4
@@ -758,37 +745,29 @@ class WarmAndCoolGroups(Intention):
         "one and the cool-coloured blocks together in the other."
     )
 
-    @staticmethod
-    def valid(state: WorldState, rel: Relations, block: str) -> bool:
+    node = ClassGroupsApart()
+
+    @classmethod
+    def valid(cls, state: WorldState, rel: Relations, block: str) -> bool:
         """On the table and not touching a block of the other kind."""
-        return on_table(rel, block) and not any(
-            rel.is_next_to(block, b) for b in state.blocks if is_warm(b) != is_warm(block)
-        )
+        return cls.node.apart(facts(state), tuple(state.blocks), block)
 
     def groups(self, state: WorldState, rel: Relations, warm: bool) -> list[list[str]]:
         members = [b for b in state.blocks if is_warm(b) == warm and self.valid(state, rel, b)]
         return _components(rel, members)
 
-    def _score(self, state: WorldState, rel: Relations) -> int:
-        return sum(len(g[0]) if (g := self.groups(state, rel, warm)) else 0 for warm in (True, False))
-
     def satisfied(self, state: WorldState) -> bool:
-        return len(state.blocks) >= 2 and self._score(state, relations(state)) == len(state.blocks)
+        return len(state.blocks) >= 2 and self.node.holds(facts(state), tuple(state.blocks), "")
 
     def score(self, state: WorldState) -> float:
-        n = len(state.blocks)
-        return self._score(state, relations(state)) / n if n else 0.0
+        return self.node.score(facts(state), tuple(state.blocks), "") if state.blocks else 0.0
 
     def step_moves_away(self, before: WorldState, after: WorldState, step: Skill) -> bool:
         if self.score(after) < self.score(before) - 1e-9:
             return True
-        rel, block = relations(after), step.block
-        if block not in after.blocks:
+        if step.block not in after.blocks:
             return False
-        if not self.valid(after, rel, block):
-            return True
-        kin = [b for b in after.blocks if b != block and is_warm(b) == is_warm(block)]
-        return bool(kin) and not any(rel.is_next_to(block, b) for b in kin)
+        return not self.node.moved_ok(facts(before), facts(after), tuple(after.blocks), step.block, "")
 
     def feasible(self, scene: Scene) -> bool:
         warm = sum(is_warm(b) for b in scene.blocks)
