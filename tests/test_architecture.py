@@ -206,11 +206,88 @@ def test_one_vocabulary_of_goals():
             assert all(type(p).__module__.startswith("activeintent.goals.") for p in parts), (family, parts)
 
 
+LANGUAGE = str(SRC / "goals" / "language.py")
+
+
+def _language_calls(call) -> set[str]:
+    """The functions of goals/language.py that ``call()`` runs (nodes judging the state)."""
+    import sys
+
+    seen: set[str] = set()
+
+    def profile(frame, event, arg):
+        if event == "call" and frame.f_code.co_filename == LANGUAGE:
+            seen.add(frame.f_code.co_name)
+
+    sys.setprofile(profile)
+    try:
+        call()
+    finally:
+        sys.setprofile(None)
+    return seen
+
+
+def _library_and_dev_intentions():
+    from activeintent.intentions.registry import INTENTION_NAMES, get_intention
+    from activeintent.intentions.suites.dev import dev_intentions
+
+    return [get_intention(n) for n in INTENTION_NAMES] + dev_intentions()
+
+
+@pytest.mark.parametrize("intention", _library_and_dev_intentions(), ids=lambda i: i.name)
+def test_library_and_dev_intentions_take_their_meaning_from_the_goal_language(intention):
+    """The library intentions and the dev suite judge a state with goals nodes (satisfied, score,
+    whether a step moves away), not with predicates of their own; scenes and oracle plans are the
+    protocol's and may stay in intentions/."""
+    import numpy as np
+
+    from activeintent.intentions.base import Intention
+    from activeintent.intentions.blockwise import BlockwiseIntention
+    from activeintent.world import PutAt, WorldState, apply_skill, relations
+    from activeintent.world.scene import layout
+
+    module = type(intention).__module__
+    assert "activeintent.goals.language" in imports(MODULES[module]), module
+    state = WorldState(positions=layout(intention.sample_scene(np.random.default_rng(0)), 0))
+    step = (intention.plan(state) or [PutAt(block=state.blocks[0], position="middle")])[0]
+    after, failure = apply_skill(state, step)
+    assert failure is None and intention.score(after) >= intention.score(state)  # no early "score drops"
+    assert _language_calls(lambda: intention.satisfied(after)), f"{intention.name}.satisfied"
+    assert _language_calls(lambda: intention.score(after)), f"{intention.name}.score"
+    if isinstance(intention, BlockwiseIntention):  # where each block is wanted
+        assert _language_calls(lambda: intention.wanted(after, relations(after), step.block)), intention.name
+    own_move_rule = type(intention).step_moves_away not in (Intention.step_moves_away, BlockwiseIntention.step_moves_away)
+    if own_move_rule:  # beyond a drop in score, the node says which moves go against it
+        assert "moved_ok" in _language_calls(lambda: intention.step_moves_away(state, after, step)), intention.name
+
+
+def module_closure(name: str) -> dict[str, str]:
+    """The activeintent modules ``name`` imports at run time, directly or through the modules
+    it imports, each with the module that imports it. Parent packages' __init__ files that
+    Python runs on the way are left out (activeintent.intentions registers the library, which is
+    goals-based by design): what counts is the code the module asks for."""
+    found: dict[str, str] = {}
+    todo = [name]
+    while todo:
+        current = todo.pop()
+        for m in sorted(runtime_imports(MODULES[current])):
+            if m in MODULES and m not in found and m != name:
+                found[m] = current
+                todo.append(m)
+    return found
+
+
 @pytest.mark.parametrize("suite", ["heldout", "heldout2"])
 def test_held_out_suites_stay_independent_of_the_goal_language(suite):
-    """Written blind with the world's helpers only (also at run time: lazy imports count), so
-    that whether the language can say them is measured, not true by construction."""
+    """Written blind with the world's helpers only (also at run time: lazy imports count, and
+    the modules they import, transitively), so that whether the language can say them is
+    measured, not true by construction."""
     path = SRC / "intentions" / "suites" / f"{suite}.py"
     assert path.exists()
     found = imports(path) | runtime_imports(path)
     assert not [m for m in found if m.startswith("activeintent.goals")], found
+    closure = module_closure(f"activeintent.intentions.suites.{suite}")
+    assert {"activeintent.intentions.base", "activeintent.intentions.blockwise", "activeintent.intentions.placement",
+            "activeintent.world"} <= set(closure)  # the walk reaches the helpers they share
+    via = {m: closure[m] for m in closure if m.startswith("activeintent.goals")}
+    assert not via, f"{suite} reaches the goal language through (module: imported by): {via}"
