@@ -1,4 +1,5 @@
-"""The vocabulary of goals, shared by the learners that reason about goals.
+"""The vocabulary of goals, shared by the learners that reason about goals and by the built-in
+intentions (the library and the dev suite judge states with its nodes).
 
 - facts.py — the relational facts of a world state (in a bowl, on a block, next to, regions, …);
 - language.py — the goal language: selectors, relations and structures in a registry, clauses,
@@ -8,6 +9,7 @@
 - recipes.py — a node of the language over a whole group with a fixed plan: the leaves of the
   bayes grammar (learners/bayes/hypotheses.py).
 
-Held-out suites never import this package: they are written with the world's helpers only, so
-that whether the language can say them is measured, not true by construction.
+Held-out suites never import this package, not even through the modules they import
+(intentions.placement, blockwise, base, lines): they are written with the world's helpers only,
+so that whether the language can say them is measured, not true by construction.
 """
