@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from activeintent.goals.facts import facts
-from activeintent.goals.language import InBowl, NextTo, OnTable, SeparateBowls
+from activeintent.goals.language import InBowl, NextTo, OnTable, SeparateBowls, own_bowl
 from activeintent.goals.language import OneBowl as OneBowlNode
 from activeintent.intentions.blockwise import BlockwiseIntention
 from activeintent.intentions.placement import free_spot
@@ -33,10 +33,6 @@ def _colors(rng: np.random.Generator, n: int, exclude: tuple[str, ...] | list[st
     return [str(c) for c in rng.choice(pool, size=n, replace=False)]
 
 
-def _own_bowl(block: str) -> str:
-    return f"{color_of(block)} bowl"
-
-
 def _blocks_in(rel: Relations, bowl: str) -> list[str]:
     return [a for a, w in rel.inside if w == bowl]
 
@@ -51,10 +47,10 @@ class ColorMatch(BlockwiseIntention):
         return self.in_bowl.ok(facts(state), block, "same")
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
-        return PutIn(block=block, bowl=_own_bowl(block)) if _own_bowl(block) in state.positions else None
+        return PutIn(block=block, bowl=own_bowl(block)) if own_bowl(block) in state.positions else None
 
     def feasible(self, scene: Scene) -> bool:
-        return len(scene.blocks) >= 1 and all(_own_bowl(b) in scene.bowls for b in scene.blocks)
+        return len(scene.blocks) >= 1 and all(own_bowl(b) in scene.bowls for b in scene.blocks)
 
     def sample_scene(self, rng: np.random.Generator) -> Scene:
         colors = _colors(rng, 2 + int(rng.integers(0, 2)))  # 2 matching pairs (+ a distractor bowl)
@@ -172,7 +168,7 @@ class NextToSameColorBowl(BlockwiseIntention):
         return self.on_table.ok(f, block, "") and self.next_to.ok(f, block, "own-bowl")
 
     def place(self, state: WorldState, rel: Relations, block: str) -> Skill | None:
-        bowl = _own_bowl(block)
+        bowl = own_bowl(block)
         if bowl not in state.positions:
             return None
 
@@ -192,7 +188,7 @@ class NextToSameColorBowl(BlockwiseIntention):
         return free_spot(state, block, ring, accept=ok)
 
     def feasible(self, scene: Scene) -> bool:
-        return len(scene.blocks) >= 1 and all(_own_bowl(b) in scene.bowls for b in scene.blocks)
+        return len(scene.blocks) >= 1 and all(own_bowl(b) in scene.bowls for b in scene.blocks)
 
     def sample_scene(self, rng: np.random.Generator) -> Scene:
         return ColorMatch().sample_scene(rng)

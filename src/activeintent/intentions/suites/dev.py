@@ -22,7 +22,7 @@ from collections.abc import Callable, Iterable, Iterator
 
 import numpy as np
 
-from activeintent.goals.facts import facts
+from activeintent.goals.facts import facts, is_warm
 from activeintent.goals.language import (
     RED_TO_PURPLE,
     AroundBowl,
@@ -48,7 +48,6 @@ from activeintent.intentions.placement import (
     free_spot,
     grid,
     is_clear,
-    is_warm,
     nearest_first,
     on_table,
     top_first,
