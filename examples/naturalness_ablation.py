@@ -40,10 +40,28 @@ END = '"'
 WEIGHTS: dict[str, float | None] = {"natural": None, "natural-strong": 0.25}  # λ; None: sd(L) / sd(N)
 
 
+# N of the starting space's sentences under the packaged model, as this file computes them: the
+# bench reads them from here, so its episodes do not depend on a machine's floating point (and
+# a fresh machine does not spend ~15 minutes scoring 3,000 sentences before its first episode).
+TABLE = Path(__file__).with_name("naturalness_bits.json")
+
+
+def _digest(model: Path) -> str:
+    return hashlib.sha256(f"{model.name}\0{model.stat().st_size}\0{FRAME}\0{END}".encode()).hexdigest()[:16]
+
+
 def _cache_path(model: Path) -> Path:
-    digest = hashlib.sha256(f"{model.name}\0{model.stat().st_size}\0{FRAME}\0{END}".encode()).hexdigest()[:16]
     root = Path(os.environ.get("ACTIVEINTENT_CACHE", Path.home() / ".cache" / "activeintent"))
-    return root / f"naturalness-{digest}.json"
+    return root / f"naturalness-{_digest(model)}.json"
+
+
+def _table(model: Path) -> dict[str, float]:
+    """The committed N values when they were computed with this model and frame, else none."""
+    try:
+        table = json.loads(TABLE.read_text())
+    except (OSError, ValueError):
+        return {}
+    return table["bits"] if table.get("digest") == _digest(model) else {}
 
 
 def sentence_bits(sentences: list[str], model: Path | None = None, threads: int = 1) -> np.ndarray:
@@ -58,6 +76,7 @@ def sentence_bits(sentences: list[str], model: Path | None = None, threads: int 
         known: dict[str, float] = json.loads(path.read_text())
     except (OSError, ValueError):
         known = {}
+    known.update(_table(model))
     todo = [s for s in dict.fromkeys(sentences) if s not in known]
     if todo:
         llm = Llama(model_path=str(model), n_ctx=512, n_threads=threads, n_threads_batch=threads,
@@ -117,9 +136,17 @@ for _variant in WEIGHTS:
         METHODS.register(f"lang-{_variant}-{_signal}", lambda v=_variant, s=_signal: _method(v, s))
 
 
-if __name__ == "__main__":  # fill the cache: python examples/naturalness_ablation.py
+if __name__ == "__main__":  # python examples/naturalness_ablation.py [--table]: fill the cache (and the table)
+    import sys
+
+    from activeintent.llm.embedded import default_gguf
+
     goals = lang_space(0, KEEP).goals
     bits = sentence_bits([g.sentence() for g in goals])
+    if "--table" in sys.argv:
+        TABLE.write_text(json.dumps({"digest": _digest(default_gguf()), "frame": FRAME, "end": END,
+                                     "bits": {g.sentence(): float(b) for g, b in zip(goals, bits, strict=True)}},
+                                    indent=0) + "\n")
     lengths = np.array([g.bits for g in goals])
     print(f"{len(goals)} goals: N mean {bits.mean():.1f} bits, sd {bits.std():.1f}; "
           f"corr(N, L) = {np.corrcoef(bits, lengths)[0, 1]:.2f}")

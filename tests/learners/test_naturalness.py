@@ -84,3 +84,17 @@ def test_the_term_is_refused_after_an_answer(ablation):
     belief.update(np.array([0.9, 0.1]))
     with pytest.raises(ValueError, match="before any answer"):
         ablation.add_naturalness(belief, np.array([1.0, 2.0]), 0.25)
+
+
+def test_the_committed_table_is_what_the_model_computes(ablation, tmp_path, monkeypatch):
+    import json
+
+    from activeintent.llm.embedded import default_gguf
+
+    table = json.loads(ablation.TABLE.read_text())
+    assert table["digest"] == ablation._digest(default_gguf()) and len(table["bits"]) == 3000
+    sentences = list(table["bits"])[::1000]
+    monkeypatch.setenv("ACTIVEINTENT_CACHE", str(tmp_path))
+    monkeypatch.setattr(ablation, "TABLE", tmp_path / "none.json")  # computed anew, not read
+    fresh = ablation.sentence_bits(sentences)
+    assert fresh == pytest.approx([table["bits"][s] for s in sentences], abs=0.05)
