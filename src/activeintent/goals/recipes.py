@@ -277,34 +277,28 @@ class LineUp(Shape):
         tries = [(a, side) for a in anchors for side in self.struct.sides]
         k = variant % len(tries)
         for anchor, side in tries[k:] + tries[:k]:
-            s, steps, prev = state, [], anchor
-            for b in sorted((o for o in g if o != anchor), key=lambda o: -state.pos(o)[2]):
-                step = PutNextTo(block=b, target=prev, side=side)
-                s, fail = apply_skill(s, step)
-                if fail is not None:
-                    break
-                steps.append(step)
-                prev = b
-            else:
-                if self.struct.holds(facts(s), g, self.param):
-                    return s, steps
+            order = [anchor] + sorted((o for o in g if o != anchor), key=lambda o: -state.pos(o)[2])
+            got = self._lined_up(state, g, [PutNextTo(block=b, target=a, side=side) for a, b in zip(order, order[1:], strict=False)])
+            if got is not None:
+                return got
         return self._along_points(state, g)
+
+    def _lined_up(self, state: WorldState, g: Group, steps: list[Skill]) -> PlanResult:
+        """``steps`` run one after another, when every one succeeds and the line then holds."""
+        for step in steps:
+            state, fail = apply_skill(state, step)
+            if fail is not None:
+                return None
+        return (state, steps) if self.struct.holds(facts(state), g, self.param) else None
 
     def _along_points(self, state: WorldState, g: Group) -> PlanResult:
         row = self.struct.axis == 1
         for c in (-0.5, -0.4, -0.6, -0.3, -0.7) if row else (0.0, -0.1, 0.1, -0.2, 0.2):
             for start in (-0.2, -0.1, 0.0) if row else (-0.7, -0.6, -0.5):
-                s, steps = state, []
-                for i, b in enumerate(g):
-                    p = (start + ROW_PITCH * i, c) if row else (c, start + ROW_PITCH * i)
-                    step = PutAt(block=b, position=p)
-                    s, fail = apply_skill(s, step)
-                    if fail is not None:
-                        break
-                    steps.append(step)
-                else:
-                    if self.struct.holds(facts(s), g, self.param):
-                        return s, steps
+                points = [(start + ROW_PITCH * i, c) if row else (c, start + ROW_PITCH * i) for i in range(len(g))]
+                got = self._lined_up(state, g, [PutAt(block=b, position=p) for b, p in zip(g, points, strict=True)])
+                if got is not None:
+                    return got
         return None
 
 
