@@ -67,7 +67,10 @@ class Registry(Generic[T]):
 
     def __getitem__(self, name: str) -> Callable[..., T]:
         """The entry registered as ``name`` itself (not called); unknown names list the valid ones."""
-        return self.factory(name)
+        try:  # the goal language reads its node types here about a million times per episode
+            return self._factories[name]
+        except KeyError:
+            return self.factory(name)
 
     def __iter__(self):
         return iter(self._factories)

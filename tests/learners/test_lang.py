@@ -114,6 +114,31 @@ def test_compiled_judge_matches_the_goals():
                     assert off[i] == g.moved_off(f0, fa, step.block), g.key
 
 
+def test_the_planners_measure_of_progress_is_the_goals_own_verdicts():
+    """Goal.value (each clause judged once) = (clauses that hold, Goal.score), to the bit."""
+    rng = np.random.default_rng(5)
+    goals = [random_goal(rng) for _ in range(200)]
+    for _goal, _scene, state in feasible_pairs(rng, 4):
+        f0 = facts(state)
+        for step in list(planner.generic_moves(state, f0, state.blocks))[::7]:
+            new, fail = apply_skill(state, step)
+            if fail is None:
+                fa = facts(new)
+                for g in goals:
+                    assert g.value(fa) == (sum(c.holds(fa) for c in g.clauses), g.score(fa)), g.key
+
+
+def test_a_steps_key_is_its_identity_as_written():
+    """skill_key: equal exactly when the reprs are (0.0 and -0.0 apart, as the planner's
+    de-duplication of moves always had them)."""
+    from activeintent.world.skills import PutAt, PutNextTo, skill_key
+
+    assert skill_key(PutAt(block="red block", position=(0.1, -0.5))) == skill_key(PutAt(block="red block", position=(0.1, -0.5)))
+    assert skill_key(PutAt(block="red block", position=(0.0, -0.5))) != skill_key(PutAt(block="red block", position=(-0.0, -0.5)))
+    assert skill_key(PutNextTo(block="red block", target="blue bowl", side="left")) != skill_key(
+        PutNextTo(block="red block", target="blue bowl", side="right"))
+
+
 def small_space(true: Goal, rng: np.random.Generator, n: int = 150) -> LangSpace:
     others = {random_goal(rng).key for _ in range(n)}
     others.discard(true.key)

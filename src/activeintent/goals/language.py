@@ -1538,6 +1538,19 @@ def quant_score(q: str, cnt, size):
     return np.minimum(cnt, n) / n
 
 
+def _quant_score_int(q: str, cnt: int, size: int) -> float:
+    """quant_score on Python ints (the same float: one IEEE division, no numpy scalars)."""
+    size = max(size, 1)
+    if q == "every":
+        return cnt / size
+    if q == "none":
+        return 1.0 - cnt / size
+    n = int(q[-1])
+    if q.startswith("exactly"):
+        return min(max(1.0 - abs(cnt - n) / max(size, n), 0.0), 1.0)
+    return min(cnt, n) / n
+
+
 # ---- clauses and goals ------------------------------------------------------------------------
 
 
@@ -1626,7 +1639,12 @@ class Each:
         return bool(quant_holds(self.quant, *self.count(f)))
 
     def score(self, f: Facts) -> float:
-        return float(quant_score(self.quant, *self.count(f)))
+        return _quant_score_int(self.quant, *self.count(f))
+
+    def judge(self, f: Facts) -> tuple[bool, float]:
+        """(holds, score) from one count (the planner's hot path)."""
+        cnt, size = self.count(f)
+        return bool(quant_holds(self.quant, cnt, size)), _quant_score_int(self.quant, cnt, size)
 
     def moved_off(self, fb: Facts, fa: Facts, b: str) -> bool:
         g = self.group_f(fa)
@@ -1800,6 +1818,15 @@ class Goal:
 
     def score(self, f: Facts) -> float:
         return sum(c.score(f) for c in self.clauses) / len(self.clauses)
+
+    def value(self, f: Facts) -> tuple[int, float]:
+        """(clauses that hold, score): the planner's measure of progress, each clause judged once."""
+        held, total = 0, 0
+        for c in self.clauses:
+            h, sc = c.judge(f)
+            held += h
+            total += sc
+        return held, total / len(self.clauses)
 
     def moved_off(self, fb: Facts, fa: Facts, b: str) -> bool:
         if self.stays and b not in self.groups(fa):

@@ -35,6 +35,7 @@ from activeintent.world import (
     apply_skill,
     layout,
 )
+from activeintent.world.skills import skill_key
 
 SIDES = ("left", "right", "front", "behind")
 REGION_SPOTS = tuple(dict.fromkeys(p for r in REGIONS for p in region_points(r)[:1]))
@@ -42,7 +43,7 @@ MAX_TRIES = 600  # candidate moves tried per plan
 
 
 def value(goal: Goal, f: Facts) -> tuple[int, float]:
-    return sum(c.holds(f) for c in goal.clauses), goal.score(f)
+    return goal.value(f)
 
 
 def generic_moves(state: WorldState, f: Facts, blocks: list[str]) -> Iterator[Skill]:
@@ -118,12 +119,12 @@ def plan(goal: Goal, state: WorldState, variant: int = 0, max_tries: int = MAX_T
 def _chain(first: list[Skill], rest: Iterator[Skill]) -> Iterator[Skill]:
     seen = set()
     for s in first:
-        k = repr(s)
+        k = skill_key(s)
         if k not in seen:
             seen.add(k)
             yield s
     for s in rest:
-        k = repr(s)
+        k = skill_key(s)
         if k not in seen:
             seen.add(k)
             yield s

@@ -62,6 +62,12 @@ class PutAt(BaseModel):
 Skill = Annotated[PutIn | PutOn | PutNextTo | PutAt, Field(discriminator="skill")]
 
 
+def skill_key(step: Skill) -> tuple:
+    """A hashable identity of a step: equal exactly when the reprs are (a point's coordinates
+    compared by repr, so that 0.0 and -0.0 stay apart), at a fraction of pydantic's repr."""
+    return (step.skill, *(repr(v) if isinstance(v, tuple) else v for v in step.__dict__.values()))
+
+
 class Plan(BaseModel):
     steps: list[Skill] = Field(default_factory=list)
 

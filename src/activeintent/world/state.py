@@ -37,7 +37,7 @@ class WorldState(BaseModel):
     def moved(self, name: str, position: tuple[float, float, float]) -> WorldState:
         new = dict(self.positions)
         new[name] = tuple(float(v) for v in position)  # type: ignore[assignment]
-        return WorldState(positions=new)
+        return WorldState.model_construct(positions=new)  # valid already: skip re-checking every position
 
     @staticmethod
     def color(name: str) -> str:
