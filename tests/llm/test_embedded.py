@@ -104,3 +104,73 @@ def test_grammar_keeps_field_order_and_forbids_raw_control_characters():
     text = _grammar_text(json.dumps({"type": "object", "properties": {"s": {"type": "string"}}}))
     char = next(line for line in text.splitlines() if line.startswith("char ::="))
     assert r"\x00-\x1F" in char
+
+
+def test_grammar_first_decoding_gives_llama_cpps_own_tokens(gguf_path):
+    """GrammarFirstGreedy (the default) writes byte for byte what llama.cpp's grammar-then-greedy
+    chain writes, on prompts where the grammar accepts the model's first choice and where it
+    refuses it (both paths are taken)."""
+    from activeintent.llm.backend import ChatRequest
+    from activeintent.llm.embedded import EmbeddedBackend, EmbeddedConfig
+    from activeintent.llm.grammar_greedy import GrammarFirstGreedy
+    from activeintent.llm.speed import BenchGoal, learner_sized_messages
+
+    class Odd(BaseModel):  # words the model would not write unprompted: the grammar must refuse
+        word: Literal["zebra", "quartz", "oblong"]
+        n: int
+
+    on = EmbeddedBackend(None, EmbeddedConfig(grammar_first=True))
+    off = EmbeddedBackend(None, EmbeddedConfig(grammar_first=False))
+    cases = [(ASK, Pick), (ASK, Odd), (learner_sized_messages(2), BenchGoal)]
+    steps = fallbacks = 0
+    for messages, schema in cases:
+        request = ChatRequest(messages=messages, max_tokens=64, seed=0, json_schema=schema.model_json_schema(),
+                              schema_name=schema.__name__)
+        want, got = off.complete(request), on.complete(request)
+        assert (got.text, got.completion_tokens, got.finish_reason) == (want.text, want.completion_tokens,
+                                                                         want.finish_reason)
+        sampler = on.llama._sampler  # the generation's sampler stays set after the call
+        assert isinstance(sampler, GrammarFirstGreedy)
+        steps, fallbacks = steps + sampler.steps, fallbacks + sampler.fallbacks
+    assert 0 < fallbacks < steps
+
+
+def test_a_kept_prefix_gives_the_logits_and_answers_of_a_fresh_evaluation(gguf_path):
+    """reuse_prefix (the default) keeps the KV cache of whole batches shared with the previous
+    prompt: the next prompt's logits are bit for bit those of evaluating it from scratch, and
+    the answers are those of a backend that never keeps anything."""
+    from activeintent.llm.backend import ChatRequest
+    from activeintent.llm.embedded import EmbeddedBackend, EmbeddedConfig, kept_prefix, turn_prompt
+    from activeintent.llm.speed import BenchGoal, growing_history_messages
+
+    on = EmbeddedBackend(None, EmbeddedConfig(reuse_prefix=True))
+    off = EmbeddedBackend(None, EmbeddedConfig(reuse_prefix=False))
+    llama = on.llama
+    prompts = [llama.tokenize(turn_prompt(growing_history_messages(r)).encode(), special=True) for r in range(3, 8)]
+
+    def last_logits():
+        return np.ctypeslib.as_array(llama._ctx.get_logits_ith(-1), shape=(llama.n_vocab(),)).copy()
+
+    kept = []
+    for before, now in zip(prompts, prompts[1:], strict=False):
+        llama.reset()
+        llama.eval(before)
+        llama.prompt_tokens = before
+        keep = kept_prefix(llama, now)
+        kept.append(keep)
+        assert keep % llama.n_batch == 0 and keep < len(now)
+        llama.n_tokens = keep
+        llama.eval(now[keep:])
+        reused = last_logits()
+        llama.reset()
+        llama.eval(now)
+        assert np.array_equal(reused, last_logits())
+    assert max(kept) > 0
+
+    schema = BenchGoal.model_json_schema()
+    requests = [ChatRequest(messages=growing_history_messages(r), max_tokens=64, seed=0, json_schema=schema,
+                            schema_name="BenchGoal") for r in range(5, 9)]
+    llama.reset()
+    llama.prompt_tokens = None
+    answers_on = [on.complete(r).text for r in requests]
+    assert [off.complete(r).text for r in requests] == answers_on

@@ -38,10 +38,17 @@ class EmbeddedConfig(BaseModel):
     n_batch: int = Field(default=512, ge=8)
     seed: int = 0
     model_dir: Path = Field(default_factory=default_model_dir)
+    grammar_first: bool = Field(
+        default=True,
+        description="structured answers at temperature 0: ask the grammar about the most likely "
+        "token first, the whole vocabulary only when it refuses (the same tokens as llama.cpp's "
+        "grammar-then-greedy chain, several times less grammar work; off: llama.cpp's chain)",
+    )
     reuse_prefix: bool = Field(
-        default=False,
-        description="keep the KV cache of the previous prompt's shared prefix (faster for "
-        "growing histories, but an answer may then depend on the call before it)",
+        default=True,
+        description="keep the KV cache of the part shared with the previous prompt, in whole "
+        "batches of n_batch tokens (faster for growing histories; bit-identical logits, so an "
+        "answer still depends on its request alone)",
     )
 
 
@@ -106,7 +113,43 @@ def load_llama(path: Path, config: EmbeddedConfig) -> Any:
             except ValueError as exc:  # llama-cpp-python's "Failed to load model from file"
                 raise ModelUnavailableError(f"cannot load GGUF model {path}: {exc}") from exc
             _CALL_LOCKS[id(_LOADED[key])] = threading.Lock()
+            _offer_grammar_first(_LOADED[key])
         return _LOADED[key]
+
+
+def kept_prefix(llama: Any, tokens: list[int]) -> int:
+    """How many leading ``tokens`` can keep their KV cache: those shared with the last prompt
+    evaluated, rounded down to whole batches of ``n_batch``. A batch's numbers depend on which
+    tokens are evaluated together (keeping an arbitrary prefix moved logits by up to 1.1), while
+    prompts evaluated in the same whole batches from position 0 give bit-identical logits
+    (docs/scaling.md); so a kept prefix ends where a batch of the from-scratch evaluation ends."""
+    last = getattr(llama, "prompt_tokens", None) or []
+    held = llama.input_ids[:llama.n_tokens].tolist()  # what the cache holds now (empty after a reset)
+    shared = 0
+    for a, h, b in zip(last, held, tokens[:-1], strict=False):  # the last token is always evaluated again
+        if not a == h == b:
+            break
+        shared += 1
+    return shared // llama.n_batch * llama.n_batch
+
+
+def _offer_grammar_first(llama: Any) -> None:
+    """Let ``llama`` decode a structured answer at temperature 0 with GrammarFirstGreedy when
+    the call asks for it (``llama.grammar_first``, set per call: backends share one Llama)."""
+    from activeintent.llm.grammar_greedy import GrammarFirstGreedy
+
+    chain = llama._init_sampler  # llama-cpp-python builds each generation's sampler here
+
+    def init_sampler(**kw):
+        plain = (kw.get("temp") == 0.0 and kw.get("logits_processor") is None and kw.get("mirostat_mode", 0) == 0
+                 and kw.get("repeat_penalty", 1.0) == 1.0 and kw.get("frequency_penalty", 0.0) == 0.0
+                 and kw.get("presence_penalty", 0.0) == 0.0)
+        if kw.get("grammar") is not None and plain and getattr(llama, "grammar_first", False):
+            return GrammarFirstGreedy(llama._model.vocab, kw["grammar"], llama.n_vocab())
+        return chain(**kw)
+
+    llama._init_sampler = init_sampler
+    llama.grammar_first = False
 
 
 _LOOSE_CHAR = r'char ::= [^"\\] |'
@@ -226,9 +269,17 @@ class EmbeddedBackend(Backend):
             grammar = LlamaGrammar.from_string(_grammar_text(schema_json), verbose=False)
             self._check_grammar(grammar)
         with self._lock:
-            if not self.config.reuse_prefix:
-                # Evaluate every prompt from scratch: an answer is a function of its request
-                # alone, as the content-addressed cache assumes.
+            self.llama.grammar_first = self.config.grammar_first
+            prompt_tokens = None
+            if not self.has_chat_template:  # the prompt as create_completion tokenizes it (a chat
+                # template's prompt is built inside llama-cpp-python: evaluated from scratch)
+                prompt = (turn_prompt if self.prompt_format == "turns" else plain_prompt)(request.messages)
+                prompt_tokens = self.llama.tokenize(prompt.encode("utf-8"), special=True)
+            keep = kept_prefix(self.llama, prompt_tokens) if self.config.reuse_prefix and prompt_tokens else 0
+            self.llama.prompt_tokens = None  # until this prompt is evaluated
+            if keep:
+                self.llama.n_tokens = keep  # llama-cpp-python then keeps exactly this prefix
+            else:
                 self.llama.reset()
             try:
                 if self.has_chat_template:
@@ -243,7 +294,7 @@ class EmbeddedBackend(Backend):
                 else:
                     turns = self.prompt_format == "turns"
                     out = self.llama.create_completion(
-                        prompt=(turn_prompt if turns else plain_prompt)(request.messages),
+                        prompt=prompt,
                         temperature=request.temperature,
                         max_tokens=request.max_tokens,
                         seed=request.seed,
@@ -253,6 +304,7 @@ class EmbeddedBackend(Backend):
                     text = out["choices"][0]["text"]
             except ValueError as exc:  # e.g. the prompt exceeds n_ctx
                 raise ModelError(f"embedded {self.model_name}: {exc}") from exc
+            self.llama.prompt_tokens = prompt_tokens
         usage = out.get("usage") or {}
         return Completion(
             text=text,

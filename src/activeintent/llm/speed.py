@@ -96,8 +96,9 @@ def run_prefix_reuse(
 ) -> dict[str, Any]:
     """An in-process model (``embedded`` or ``gguf:``) answers ``prompts`` learner-sized prompts
     whose history grows by one round each, once evaluating every prompt from scratch
-    (``reuse_prefix`` off, the default) and once keeping the KV cache of the part shared with
-    the previous prompt (on). Reports both latencies and whether every answer is byte-identical.
+    (``reuse_prefix`` off) and once keeping the KV cache of the whole batches shared with the
+    previous prompt (on, the default). Reports both latencies and whether every answer is
+    byte-identical.
     """
     from activeintent.llm.backend import ChatRequest
     from activeintent.llm.embedded import EmbeddedBackend
@@ -143,6 +144,49 @@ def run_prefix_reuse(
         "on": {"latency_s": on_s, "latency_s_mean": round(statistics.fmean(on_s), 4)},
         # The first prompt of each series has nothing to reuse; the rest show the gain.
         "speedup_after_first": round(sum(off_s[1:]) / sum(on_s[1:]), 3) if prompts > 1 else None,
+    }
+
+
+def run_grammar_first(
+    spec: str = "embedded",
+    *,
+    embedded: EmbeddedConfig | None = None,
+    prompts: int = 4,
+    max_tokens: int = 160,
+) -> dict[str, Any]:
+    """An in-process model answers ``prompts`` learner-sized structured prompts with llama.cpp's
+    own grammar-then-greedy chain (``grammar_first`` off) and with GrammarFirstGreedy (on, the
+    default); reports both latencies and whether every answer is byte-identical."""
+    from activeintent.llm.backend import ChatRequest
+    from activeintent.llm.embedded import EmbeddedBackend
+    from activeintent.llm.registry import parse_spec
+
+    parsed = parse_spec(spec)
+    if parsed.kind not in ("embedded", "gguf"):
+        raise ValueError(f"grammar_first is a setting of the in-process model, not of {spec}")
+    config = embedded or EmbeddedConfig()
+    path = parsed.target if parsed.kind == "gguf" else None
+    backends = {flag: EmbeddedBackend(path, config.model_copy(update={"grammar_first": flag, "reuse_prefix": False}))
+                for flag in (False, True)}
+    schema = BenchGoal.model_json_schema()
+    backends[True].complete(ChatRequest(messages=learner_sized_messages(0), max_tokens=8))  # warm-up
+    texts: dict[bool, list[str]] = {False: [], True: []}
+    seconds: dict[bool, list[float]] = {False: [], True: []}
+    for k in range(prompts):
+        request = ChatRequest(messages=learner_sized_messages(k + 1), max_tokens=max_tokens, seed=config.seed,
+                              json_schema=schema, schema_name="BenchGoal")
+        for flag in (False, True):  # alternated, so a drift in the machine's speed hits both
+            started = time.perf_counter()
+            texts[flag].append(backends[flag].complete(request).text)
+            seconds[flag].append(round(time.perf_counter() - started, 4))
+    differ = [i for i, (a, b) in enumerate(zip(texts[False], texts[True], strict=True)) if a != b]
+    return {
+        "prompts": prompts,
+        "identical": not differ,
+        "differing_prompts": differ,
+        "off": {"latency_s": seconds[False], "latency_s_mean": round(statistics.fmean(seconds[False]), 4)},
+        "on": {"latency_s": seconds[True], "latency_s_mean": round(statistics.fmean(seconds[True]), 4)},
+        "speedup": round(sum(seconds[False]) / sum(seconds[True]), 3),
     }
 
 
@@ -196,4 +240,5 @@ def run_model_bench(
         result["n_ctx"] = embedded.n_ctx
     if reuse_prompts > 0 and (spec == "embedded" or spec.startswith("gguf:")):
         result["prefix_reuse"] = run_prefix_reuse(spec, embedded=embedded, prompts=reuse_prompts)
+        result["grammar_first"] = run_grammar_first(spec, embedded=embedded, prompts=reuse_prompts)
     return result
