@@ -21,7 +21,7 @@ import json
 import math
 import os
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -119,9 +119,17 @@ class Clause:
         skip = self.leaf.excluded()
         return tuple(b for b in blocks if sel(b) and b != skip)
 
+    @cached_property
+    def _judge_key(self) -> tuple:  # built once: judge_f runs ~10^5 times per episode
+        return ("clause", self.selector, self.behaviour.key)
+
+    @cached_property
+    def _group_key(self) -> tuple:
+        return (self.selector, self.leaf.excluded())
+
     def judge_f(self, f: Facts) -> tuple[bool, float, int]:
         """(holds, score, group size) on ``f``, memoised: many hypotheses share a clause."""
-        key = ("clause", self.selector, self.behaviour.key)
+        key = self._judge_key
         got = f.memo.get(key)
         if got is None:
             g = self.group_f(f)
@@ -129,7 +137,7 @@ class Clause:
         return got
 
     def group_f(self, f: Facts) -> tuple[str, ...]:
-        key = (self.selector, self.leaf.excluded())
+        key = self._group_key
         g = f.memo.get(key)
         if g is None:
             g = f.memo[key] = self.group(f.blocks)
