@@ -83,6 +83,7 @@ class Compiled:
         self._f_sel = np.array(self.f_sel, int)
         self._f_shape = np.array(self.f_shape, int)
         self._possible: dict[tuple[str, ...], np.ndarray] = {}
+        self._selected: dict[tuple, np.ndarray] = {}
         self._tag = ("lang", next(_TOKENS))  # unique per judge (an id() can be reused)
 
     # -- per state --
@@ -95,8 +96,14 @@ class Compiled:
         blocks = f.blocks
         bowls = tuple(f.bowls)
         objects = set(blocks) | set(bowls)
-        S = np.array([[NODES["selector"][s].pick(b, bowls, p) for b in blocks] for s, p in self.sels], bool)
-        S = S.reshape(len(self.sels), len(blocks))
+        S = self._selected.get((blocks, bowls))
+        if S is None:  # who each selector picks depends on the names only: once per scene
+            S = np.array([[NODES["selector"][s].pick(b, bowls, p) for b in blocks] for s, p in self.sels], bool)
+            S = S.reshape(len(self.sels), len(blocks))
+            S.flags.writeable = False  # shared by every state of the scene
+            if len(self._selected) > 4096:
+                self._selected.clear()
+            self._selected[(blocks, bowls)] = S
         R = np.zeros((len(self.rels), len(blocks)), bool)
         X = np.zeros_like(R)
         for j, (r, p) in enumerate(self.rels):
