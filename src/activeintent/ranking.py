@@ -38,3 +38,13 @@ def argmax(values, decimals: int = DECIMALS) -> int:
 def greater(a: float, b: float, decimals: int = DECIMALS) -> bool:
     """``a > b`` beyond float noise."""
     return float(quantised(a, decimals)) > float(quantised(b, decimals))
+
+
+PLAN_STEP_COST = 1e-6  # a final answer's tie-break: among equally good plans, the shorter
+
+
+def best_plan(values, plan_lengths) -> int:
+    """Index of the final answer: the largest value (an expected success, a reward) less
+    PLAN_STEP_COST per step, so that of two plans as good as each other the shorter is run;
+    the first among ties."""
+    return argmax(np.asarray(values, dtype=float) - PLAN_STEP_COST * np.asarray(plan_lengths, dtype=float))

@@ -58,3 +58,13 @@ def test_choices_among_near_ties_ignore_float_noise():
     assert list(ranking.order([0.1, a, b])) == [1, 2, 0]
     assert not ranking.greater(a, b) and not ranking.greater(b, a)
     assert ranking.argmax([0.5, 0.5 + 1e-6]) == 1  # a real difference still counts
+
+
+def test_a_final_answer_runs_the_shorter_of_two_equally_good_plans():
+    """ranking.best_plan, the tie-break of every learner's final answer: equal values (even
+    equal only up to float noise) go to the shorter plan; a real difference in value beats
+    any difference in length of a few steps."""
+    a = np.array([0.1, 0.2, 0.3]).sum()  # 0.6000000000000001
+    assert ranking.best_plan([a, 0.6], [4, 2]) == 1 and ranking.best_plan([0.6, a], [2, 4]) == 0
+    assert ranking.best_plan([0.6, 0.6], [3, 3]) == 0  # then the first
+    assert ranking.best_plan([0.6, 0.61], [1, 6]) == 1

@@ -122,9 +122,9 @@ class HybridLearner(Learner):
         # Bayes' decision over both classes: P(the outcome is what the person wants) is, under
         # M_L, Σ_z w_z 1[z holds]; under M_R, P(no candidate has a larger reward w · φ).
         w, feasible = self.lang.scene_weights(scene)
-        outs = self.lang._final_outcomes(state, w, feasible) + self.reward.final_outcomes(state)
+        outs = self.lang.final_outcomes(state, w, feasible) + self.reward.final_outcomes(state)
         score = (1 - p) * self.lang.expected_success(w, outs) + p * self.reward.p_best(outs)
-        best = ranking.argmax(score - 1e-6 * np.array([len(o.plan) for o in outs]))
+        best = ranking.best_plan(score, [len(o.plan) for o in outs])
         plan = outs[best].plan
         z = self.lang.top()[0][0].description if p <= 0.5 else self.reward.describe()
         return Estimate(z=z, goals=[describe_plan(plan)], plans=[plan], done=True,

@@ -334,9 +334,9 @@ class BayesLearner(Learner):
         """The plan with the largest expected success Σ_z w_z 1[z satisfied by its outcome],
         among the plans of the hypotheses that can be shown in this scene."""
         w, feasible = self.scene_weights(scene)
-        outs = self._final_outcomes(state, w, feasible)
+        outs = self.final_outcomes(state, w, feasible)
         success = self.expected_success(w, outs)
-        best = ranking.argmax(success - 1e-6 * np.array([len(o.plan) for o in outs]))
+        best = ranking.best_plan(success, [len(o.plan) for o in outs])
         top = self.hyps[ranking.argmax(w, ranking.WEIGHT_DECIMALS)]
         plan = outs[best].plan
         return Estimate(z=top.description, goals=[describe_plan(plan)], plans=[plan], done=True,
@@ -355,7 +355,7 @@ class BayesLearner(Learner):
         self.judge.prefetch(finals)
         return np.array([float(w @ self.judge.judge(f)[0]) for f in finals])
 
-    def _final_outcomes(self, state: WorldState, w: np.ndarray, feasible: np.ndarray) -> list:
+    def final_outcomes(self, state: WorldState, w: np.ndarray, feasible: np.ndarray) -> list:
         """What the final answer chooses among: doing nothing and the likely z's plans."""
         return [predict(state, [])] + candidate_plans(
             self.hyps, w, state, self.rng, top_k=self.config.final_top_k, explore=0,

@@ -179,12 +179,12 @@ class LangLearner(BayesLearner):
                 self.log[-1]["neighbours_added"] = n
         return out
 
-    def _final_outcomes(self, state: WorldState, w: np.ndarray, feasible: np.ndarray) -> list:
+    def final_outcomes(self, state: WorldState, w: np.ndarray, feasible: np.ndarray) -> list:
         """Bayes' decision over more plans: besides each likely goal's own plans, a plan for
         the conjunction of two likely goals (their clauses together), so that a belief split
         between compatible goals can be answered by a plan that satisfies both; every plan is
         still chosen by its expected success Σ_z w_z 1[z holds after it]."""
-        outs = super()._final_outcomes(state, w, feasible)
+        outs = super().final_outcomes(state, w, feasible)
         m = self.config.final_joint
         if m < 2:
             return outs

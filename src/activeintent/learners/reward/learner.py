@@ -242,7 +242,7 @@ class RewardLearner(Learner):
         mean = self.belief.mean()
         outs = self.final_outcomes(state)
         values = np.array([mean @ self.phi(o.traj.outcome) for o in outs])
-        best = ranking.argmax(values - 1e-6 * np.array([len(o.plan) for o in outs]))
+        best = ranking.best_plan(values, [len(o.plan) for o in outs])
         plan = outs[best].plan
         return Estimate(z=self.describe(), goals=[describe_plan(plan)], plans=[plan], done=True,
                         why={"expected_reward": round(float(values[best]), 4), "candidates": len(outs)})
