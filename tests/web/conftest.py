@@ -127,8 +127,8 @@ def http() -> Iterator[httpx.Client]:
         yield c
 
 
-@pytest.fixture(scope="session")
-def browser():
+@pytest.fixture(scope="module")  # not session: Playwright's sync API keeps an event loop running
+def browser():  # in the main thread while it is open, and asyncio.run in later modules would fail
     if not Path(CHROMIUM).exists():
         pytest.skip(f"{CHROMIUM} is missing: apt-get install chromium (bin/test does)")
     from playwright.sync_api import sync_playwright
