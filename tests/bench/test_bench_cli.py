@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 from activeintent.cli import app
@@ -60,6 +61,21 @@ def test_perf_bench_prints_a_line_per_episode_on_stderr_and_keeps_stdout_json():
     assert json.loads(res.stdout)["settings"]["symbolic"]["signals"] == 1
     line = next(line for line in res.stderr.splitlines() if line.startswith("1/1 · "))
     assert line.split(" · ")[:4] == ["1/1", "bayes-stop", "symbolic", "color-match"] and "ETA" in line
+
+
+def test_perf_bench_splits_an_episode_into_per_signal_work_and_the_rest():
+    """outside_signals_s: the episode less the learner's per-signal work; for a method that
+    asks nothing, the whole episode (and no per-signal figures, not a crash)."""
+    res = runner.invoke(app, ["perf-bench", "--json", "--episodes", "1", "--envs", "symbolic", "--budget", "2"])
+    got = json.loads(res.stdout)["settings"]["symbolic"]
+    assert 0 < got["outside_signals_s_median"] < got["episode_s_median"]
+    assert got["outside_signals_s_median"] + 2 * got["learner_s_per_signal_median"] == pytest.approx(
+        got["episode_s_median"], abs=0.5 * got["episode_s_median"])
+    res = runner.invoke(app, ["perf-bench", "--json", "--method", "zero-signal", "--episodes", "1", "--envs", "symbolic",
+                              "--budget", "2"])
+    assert res.exit_code == 0, res.output
+    got = json.loads(res.stdout)["settings"]["symbolic"]
+    assert got["outside_signals_s_median"] == got["episode_s_median"] and got["learner_s_per_signal_median"] is None
 
 
 def test_the_report_carries_the_oracle_row_measured_by_coverage(tmp_path):

@@ -28,8 +28,9 @@ def perf_bench(
     intentions: Annotated[str, typer.Option("--intentions", help="comma-separated hidden intentions")] = "color-match",
     budget: Annotated[int, typer.Option(min=1, help="signals per episode")] = 5,
 ) -> None:
-    """Time per phase and per episode of fixed `run`-like episodes (no video, no model), and the
-    learner's time per signal (choosing the query, reading the answer; scoring excluded)."""
+    """Time per phase and per episode of fixed `run`-like episodes (no video, no model), the
+    learner's time per signal (choosing the query, reading the answer; scoring excluded), and
+    the time of an episode outside that per-signal work (scoring, env, user, records)."""
     from activeintent.runner import RunSpec, build_episode
 
     class RoundTimes:
@@ -51,9 +52,10 @@ def perf_bench(
     done = 0
     out: dict = {"method": method, "episodes": episodes, "intentions": names, "budget": budget, "settings": {}}
     for env in env_names:
-        walls, phases, rounds = [], [], RoundTimes()
+        walls, phases, rounds, outside = [], [], RoundTimes(), []
         for name in names:
             for seed in range(episodes):
+                signals_before = len(rounds.learner_s)
                 options = RunSpec.from_options(method=method, intention=name, env=env, llm="none", video="none", seed=seed,
                                      budget=budget)
                 start = time.perf_counter()
@@ -65,6 +67,8 @@ def perf_bench(
                     episode.env.close()
                 walls.append(time.perf_counter() - start)
                 phases.append(result.time_split)
+                # everything but the learner's own per-signal work: scoring, env, user, records
+                outside.append(walls[-1] - sum(rounds.learner_s[signals_before:]))
                 done += 1
                 print_line(log, f"{done}/{eta.total} · {method} · {env} · {name} · seed {seed} · "
                            f"{walls[-1]:.1f} s · {eta.text(done)}")
@@ -73,8 +77,11 @@ def perf_bench(
             "episode_s_median": round(statistics.median(walls), 3),
             "episode_s_max": round(max(walls), 3),
             "phase_s_mean": {k: round(statistics.fmean(p[k] for p in phases), 3) for k in keys},
-            "learner_s_per_signal_median": round(statistics.median(rounds.learner_s), 3),
-            "learner_s_per_signal_p90": round(sorted(rounds.learner_s)[int(0.9 * (len(rounds.learner_s) - 1))], 3),
+            "outside_signals_s_median": round(statistics.median(outside), 3),
+            # None for a method that asks nothing (zero-signal)
+            "learner_s_per_signal_median": round(statistics.median(rounds.learner_s), 3) if rounds.learner_s else None,
+            "learner_s_per_signal_p90": (round(sorted(rounds.learner_s)[int(0.9 * (len(rounds.learner_s) - 1))], 3)
+                                         if rounds.learner_s else None),
             "signals": len(rounds.learner_s),
         }
     if as_json:
