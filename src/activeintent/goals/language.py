@@ -31,8 +31,6 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from itertools import combinations, permutations
 
-import numpy as np
-
 from activeintent.goals.facts import ALIGN_TOL, Facts, facts
 from activeintent.goals.planning import GRID, area_points
 from activeintent.registry import Registry
@@ -1526,20 +1524,9 @@ def quant_holds(q: str, cnt, size):
     return cnt == n if q.startswith("exactly") else cnt >= n
 
 
-def quant_score(q: str, cnt, size):
-    size = np.maximum(size, 1)
-    if q == "every":
-        return cnt / size
-    if q == "none":
-        return 1.0 - cnt / size
-    n = int(q[-1])
-    if q.startswith("exactly"):
-        return np.clip(1.0 - np.abs(cnt - n) / np.maximum(size, n), 0.0, 1.0)
-    return np.minimum(cnt, n) / n
-
-
-def _quant_score_int(q: str, cnt: int, size: int) -> float:
-    """quant_score on Python ints (the same float: one IEEE division, no numpy scalars)."""
+def quant_score(q: str, cnt: int, size: int) -> float:
+    """How close a count is to the quantifier (Python ints: one IEEE division per score, no
+    numpy scalars; learners/lang/space.py computes the same scores for many clauses at once)."""
     size = max(size, 1)
     if q == "every":
         return cnt / size
@@ -1639,12 +1626,12 @@ class Each:
         return bool(quant_holds(self.quant, *self.count(f)))
 
     def score(self, f: Facts) -> float:
-        return _quant_score_int(self.quant, *self.count(f))
+        return quant_score(self.quant, *self.count(f))
 
     def judge(self, f: Facts) -> tuple[bool, float]:
         """(holds, score) from one count (the planner's hot path)."""
         cnt, size = self.count(f)
-        return bool(quant_holds(self.quant, cnt, size)), _quant_score_int(self.quant, cnt, size)
+        return bool(quant_holds(self.quant, cnt, size)), quant_score(self.quant, cnt, size)
 
     def moved_off(self, fb: Facts, fa: Facts, b: str) -> bool:
         g = self.group_f(fa)
