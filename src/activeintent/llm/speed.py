@@ -86,6 +86,33 @@ def _rate(usage: Usage, run: Any) -> dict[str, float]:
     }
 
 
+def _setting_pair(spec: str, embedded: EmbeddedConfig | None, setting: str, **fixed: Any):
+    """(config, backend with ``setting`` off, backend with it on) of an in-process model
+    (``embedded`` or ``gguf:``), ``fixed`` in both; the two share one loaded model (these
+    settings are not part of what is loaded)."""
+    from activeintent.llm.embedded import EmbeddedBackend
+    from activeintent.llm.registry import parse_spec
+
+    parsed = parse_spec(spec)
+    if parsed.kind not in ("embedded", "gguf"):
+        raise ValueError(f"{setting} is a setting of the in-process model, not of {spec}")
+    config = embedded or EmbeddedConfig()
+    path = parsed.target if parsed.kind == "gguf" else None
+    off, on = (EmbeddedBackend(path, config.model_copy(update={**fixed, setting: flag})) for flag in (False, True))
+    return config, off, on
+
+
+def _compared(off_texts: list[str], on_texts: list[str], off_s: list[float], on_s: list[float]) -> dict[str, Any]:
+    """Whether every answer is byte-identical with the setting off and on, and both latencies."""
+    differ = [i for i, (a, b) in enumerate(zip(off_texts, on_texts, strict=True)) if a != b]
+    return {
+        "identical": not differ,
+        "differing_prompts": differ,
+        "off": {"latency_s": off_s, "latency_s_mean": round(statistics.fmean(off_s), 4)},
+        "on": {"latency_s": on_s, "latency_s_mean": round(statistics.fmean(on_s), 4)},
+    }
+
+
 def run_prefix_reuse(
     spec: str = "embedded",
     *,
@@ -102,16 +129,8 @@ def run_prefix_reuse(
     """
     from activeintent.llm.backend import ChatRequest
     from activeintent.llm.embedded import EmbeddedBackend
-    from activeintent.llm.registry import parse_spec
 
-    parsed = parse_spec(spec)
-    if parsed.kind not in ("embedded", "gguf"):
-        raise ValueError(f"prefix reuse is a setting of the in-process model, not of {spec}")
-    config = embedded or EmbeddedConfig()
-    path = parsed.target if parsed.kind == "gguf" else None
-    # Both share one loaded model (the KV cache setting is not part of what is loaded).
-    scratch = EmbeddedBackend(path, config.model_copy(update={"reuse_prefix": False}))
-    reuse = EmbeddedBackend(path, config.model_copy(update={"reuse_prefix": True}))
+    config, scratch, reuse = _setting_pair(spec, embedded, "reuse_prefix")
     schema = BenchGoal.model_json_schema()
     requests = [
         ChatRequest(messages=growing_history_messages(first_rounds + k), max_tokens=max_tokens,
@@ -134,14 +153,10 @@ def run_prefix_reuse(
     off_texts, off_s, prompt_tokens = series(scratch)
     on_texts, on_s, _ = series(reuse)
     scratch.llama.reset()
-    differ = [i for i, (a, b) in enumerate(zip(off_texts, on_texts, strict=True)) if a != b]
     return {
         "prompts": prompts,
         "prompt_tokens": prompt_tokens,
-        "identical": not differ,
-        "differing_prompts": differ,
-        "off": {"latency_s": off_s, "latency_s_mean": round(statistics.fmean(off_s), 4)},
-        "on": {"latency_s": on_s, "latency_s_mean": round(statistics.fmean(on_s), 4)},
+        **_compared(off_texts, on_texts, off_s, on_s),
         # The first prompt of each series has nothing to reuse; the rest show the gain.
         "speedup_after_first": round(sum(off_s[1:]) / sum(on_s[1:]), 3) if prompts > 1 else None,
     }
@@ -158,16 +173,9 @@ def run_grammar_first(
     own grammar-then-greedy chain (``grammar_first`` off) and with GrammarFirstGreedy (on, the
     default); reports both latencies and whether every answer is byte-identical."""
     from activeintent.llm.backend import ChatRequest
-    from activeintent.llm.embedded import EmbeddedBackend
-    from activeintent.llm.registry import parse_spec
 
-    parsed = parse_spec(spec)
-    if parsed.kind not in ("embedded", "gguf"):
-        raise ValueError(f"grammar_first is a setting of the in-process model, not of {spec}")
-    config = embedded or EmbeddedConfig()
-    path = parsed.target if parsed.kind == "gguf" else None
-    backends = {flag: EmbeddedBackend(path, config.model_copy(update={"grammar_first": flag, "reuse_prefix": False}))
-                for flag in (False, True)}
+    config, *pair = _setting_pair(spec, embedded, "grammar_first", reuse_prefix=False)
+    backends = dict(zip((False, True), pair, strict=True))
     schema = BenchGoal.model_json_schema()
     backends[True].complete(ChatRequest(messages=learner_sized_messages(0), max_tokens=8))  # warm-up
     texts: dict[bool, list[str]] = {False: [], True: []}
@@ -179,13 +187,9 @@ def run_grammar_first(
             started = time.perf_counter()
             texts[flag].append(backends[flag].complete(request).text)
             seconds[flag].append(round(time.perf_counter() - started, 4))
-    differ = [i for i, (a, b) in enumerate(zip(texts[False], texts[True], strict=True)) if a != b]
     return {
         "prompts": prompts,
-        "identical": not differ,
-        "differing_prompts": differ,
-        "off": {"latency_s": seconds[False], "latency_s_mean": round(statistics.fmean(seconds[False]), 4)},
-        "on": {"latency_s": seconds[True], "latency_s_mean": round(statistics.fmean(seconds[True]), 4)},
+        **_compared(texts[False], texts[True], seconds[False], seconds[True]),
         "speedup": round(sum(seconds[False]) / sum(seconds[True]), 3),
     }
 
