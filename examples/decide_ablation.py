@@ -18,10 +18,14 @@
 - ``decide-split-stop`` (a variant): stop queries may also show plans grown step by step, each
   step moving away from about half of the likely goals left (``BayesConfig.split = 3``);
 - ``decide-joint-<signal>`` (a variant): the final answer may also run a plan for both goals of a
-  pair of the 4 likeliest goals (``LangConfig.final_joint = 4``).
+  pair of the 4 likeliest goals (``LangConfig.final_joint = 4``);
+- ``decide-wide-<signal>`` (a variant): a wider query search, twice the candidate scenes kept and
+  drawn, plans from the 32 likeliest goals, up to 64 plans per scene;
+- ``decide-keep10000-<signal>`` (a variant): the belief starts from the 10,000 shortest goals of the
+  language instead of ``learner.KEEP`` = 3,000 (the cut rises from 15.8 to 17.9 bits).
 """
 
-from activeintent.learners.lang.learner import DECIDE, LangConfig, LangLearner
+from activeintent.learners.lang.learner import DECIDE, KEEP, LangConfig, LangLearner
 from activeintent.learners.registry import METHODS, LearnerContext, Method
 
 ABLATIONS = {
@@ -34,8 +38,11 @@ ABLATIONS = {
     "chains": {"chains": 4},
     "joint": {"final_joint": 4},
     "split": {"split": 3},
+    "wide": {"n_scenes": 8, "scene_candidates": 32, "max_plans": 64, "top_k": 32},
+    "keep10000": {},
 }
-VARIANTS = ("needs-scenes", "chains", "joint", "split")
+VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000")
+START_SPACE = {"keep10000": 10000}  # goals the belief starts from, where a variant changes it
 
 
 def _ablation(part: str, signal: str) -> Method:
@@ -43,12 +50,14 @@ def _ablation(part: str, signal: str) -> Method:
 
     def build(ctx: LearnerContext) -> LangLearner:
         config = LangConfig(prior=ctx.config.prior, **{**DECIDE, **ABLATIONS[part]})
-        learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=config)
+        learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=config,
+                              keep=START_SPACE.get(part, KEEP))
         learner.name = name
         return learner
 
     kind = "variant" if part in VARIANTS else "ablation"
-    return Method(signal, False, build, f"{kind}: decide-{signal} with {ABLATIONS[part]}")
+    change = ABLATIONS[part] or {"start space": START_SPACE[part]}
+    return Method(signal, False, build, f"{kind}: decide-{signal} with {change}")
 
 
 for _part in ABLATIONS:
