@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 from typer.testing import CliRunner
 
@@ -75,3 +76,22 @@ def test_run_prints_a_line_per_signal_when_stdout_is_not_a_terminal(tmp_path):
     assert "success@1 = " in lines[progress[1]] and "ETA" in lines[progress[1]]
     table = next(i for i, line in enumerate(lines) if "bayes-stop on a hidden intention" in line)
     assert progress[-1] < table
+
+
+def test_a_bench_record_replays_with_its_seed_and_test_seed(tmp_path):
+    """`run --seed S --test-seed T` is the bench's episode: a committed record's success@k comes back
+    (T is the record's config.options.test_seed; the top-level test_seed is the test stream's)."""
+    results = Path(__file__).resolve().parents[1] / "docs" / "results" / "truth-goals-exact" / "results.jsonl"
+    record = next(r for r in map(json.loads, results.read_text().splitlines())
+                  if r["method"] == "zero-signal" and r["intention"] == "truth-05")
+    options = record["config"]["options"]
+    args = ["run", "--method", "zero-signal", "--intention", "truth-05", "--budget", str(record["budget"]),
+            "--user", options["user"], "--env", "symbolic", "--llm", "none", "--video", "none",
+            "--seed", str(record["seed"])]
+    res = runner.invoke(app, [*args, "--test-seed", str(options["test_seed"]), "--out", str(tmp_path / "replay")])
+    assert res.exit_code == 0, res.output
+    replay = json.loads((tmp_path / "replay" / "summary.json").read_text())
+    assert (replay["success_at"], replay["test_scored"]) == (record["success_at"], record["test_scored"])
+    res = runner.invoke(app, [*args, "--out", str(tmp_path / "own")])  # the test scenes follow --seed alone
+    own = json.loads((tmp_path / "own" / "summary.json").read_text())
+    assert (own["success_at"], own["test_scored"]) != (record["success_at"], record["test_scored"])

@@ -20,6 +20,7 @@ IntentionFile = Annotated[str | None, typer.Option("--intention-file", help="You
 Plugin = Annotated[list[str] | None, typer.Option("--plugin", help="Python file registering signals, methods, envs… (repeatable)")]
 Budget = Annotated[int, typer.Option("--budget", min=0, max=100, help="K: signals the user gives; every answer counts")]
 Seed = Annotated[int, typer.Option("--seed", min=0, help="Seed of every random choice")]
+TestSeed = Annotated[int | None, typer.Option("--test-seed", min=0, help="Seed of the test scenes (default: from --seed); a bench record's config.options.test_seed replays its episode")]
 TestScenes = Annotated[int, typer.Option("--test-scenes", min=1, max=200, help="Test scenes scored after every signal")]
 TestPool = Annotated[int, typer.Option("--test-pool", min=0, max=1000, help="More test scenes, scored after the last signal (k = K)")]
 Env = Annotated[str, typer.Option("--env", help="Where plans run: pybullet | symbolic")]

@@ -109,6 +109,7 @@ def run(
     plugin: opt.Plugin = None,
     budget: opt.Budget = D.budget,
     seed: opt.Seed = D.seed,
+    test_seed: opt.TestSeed = None,
     test_scenes: opt.TestScenes = D.test_scenes,
     test_pool: opt.TestPool = D.test_pool,
     env: opt.Env = D.env,
@@ -149,7 +150,7 @@ def run(
     try:
         spec = opt.run_spec(
             method=method, intention=intention, intention_file=intention_file, plugins=plugin, budget=budget,
-            seed=seed, test_scenes=test_scenes, test_pool=test_pool, env=env, user=user, new_scene=new_scene, prior=prior, llm=llm,
+            seed=seed, test_seed=test_seed, test_scenes=test_scenes, test_pool=test_pool, env=env, user=user, new_scene=new_scene, prior=prior, llm=llm,
             vlm=vlm, base_url=base_url, cache=cache, cache_mode=cache_mode, executor=executor,
             retriever=retriever, epsilon=epsilon, early_threshold=early_threshold, variant=variant, video=video,
             design_scenes=design_scenes,
