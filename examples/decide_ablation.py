@@ -39,25 +39,24 @@ ABLATIONS = {
     "joint": {"final_joint": 4},
     "split": {"split": 3},
     "wide": {"n_scenes": 8, "scene_candidates": 32, "max_plans": 64, "top_k": 32},
-    "keep10000": {},
+    "keep10000": {"keep": 10000},  # not a LangConfig field: the goals the belief starts from
 }
 VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000")
-START_SPACE = {"keep10000": 10000}  # goals the belief starts from, where a variant changes it
 
 
 def _ablation(part: str, signal: str) -> Method:
     name = f"decide-{part}-{signal}"
 
     def build(ctx: LearnerContext) -> LangLearner:
-        config = LangConfig(prior=ctx.config.prior, **{**DECIDE, **ABLATIONS[part]})
-        learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=config,
-                              keep=START_SPACE.get(part, KEEP))
+        settings = {**DECIDE, **ABLATIONS[part]}
+        keep = settings.pop("keep", KEEP)
+        config = LangConfig(prior=ctx.config.prior, **settings)
+        learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=config, keep=keep)
         learner.name = name
         return learner
 
     kind = "variant" if part in VARIANTS else "ablation"
-    change = ABLATIONS[part] or {"start space": START_SPACE[part]}
-    return Method(signal, False, build, f"{kind}: decide-{signal} with {change}")
+    return Method(signal, False, build, f"{kind}: decide-{signal} with {ABLATIONS[part]}")
 
 
 for _part in ABLATIONS:
