@@ -22,7 +22,9 @@
 - ``decide-wide-<signal>`` (a variant): a wider query search, twice the candidate scenes kept and
   drawn, plans from the 32 likeliest goals, up to 64 plans per scene;
 - ``decide-keep10000-<signal>`` (a variant): the belief starts from the 10,000 shortest goals of the
-  language instead of ``learner.KEEP`` = 3,000 (the cut rises from 15.8 to 17.9 bits).
+  language instead of ``learner.KEEP`` = 3,000 (the cut rises from 15.8 to 17.9 bits);
+- ``decide-counts-<signal>`` (a variant): the needs belief also has literals that count the blocks a
+  selector of the language picks ("at least two cool blocks"; ``BayesConfig.needs_counts``).
 """
 
 from activeintent.learners.lang.learner import DECIDE, KEEP, LangConfig, LangLearner
@@ -40,8 +42,9 @@ ABLATIONS = {
     "split": {"split": 3},
     "wide": {"n_scenes": 8, "scene_candidates": 32, "max_plans": 64, "top_k": 32},
     "keep10000": {"keep": 10000},  # not a LangConfig field: the goals the belief starts from
+    "counts": {"needs_counts": True},
 }
-VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000")
+VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000", "counts")
 
 
 def _ablation(part: str, signal: str) -> Method:

@@ -126,6 +126,27 @@ def test_needs_scenes_meet_the_requirement_the_needs_belief_holds():
     assert red_share("needs") == 1.0 and red_share("belief") < 0.9  # belief keeps the 4 best of 16 draws
 
 
+def test_the_needs_belief_learns_a_count_only_with_count_literals():
+    """Refused: scenes with fewer than two cool blocks; answered: scenes with two. Only the belief
+    with count literals can say "at least two cool blocks" (the base literals cannot count)."""
+    from activeintent.learners.bayes.needs import Needs
+
+    refused = [("blue block", "red block", "blue bowl"), ("green block", "orange block", "pink block", "red bowl"),
+               ("purple block", "yellow block", "brown bowl"), ("cyan block", "red block", "gray bowl", "red bowl")]
+    answered = [("blue block", "green block", "red bowl"), ("cyan block", "purple block", "yellow block", "blue bowl"),
+                ("gray block", "blue block", "orange bowl")]
+    tops = []
+    for counts in (True, False):
+        needs = Needs(0.1, counts)
+        for objects in refused:
+            needs.update(objects, True, shown=0.9)
+        for objects in answered:
+            needs.update(objects, False, shown=0.9)
+        tops.append(needs.top(1)[0])
+    assert tops[0][0] == "2+ class:cool" and tops[0][1] > 0.4
+    assert "2+" not in tops[1][0]
+
+
 def test_a_chained_plan_does_one_likely_goal_then_another():
     from activeintent.learners.bayes.candidates import chained_plans, predict
     from activeintent.learners.bayes.hypotheses import random_scene
@@ -154,9 +175,9 @@ def test_goals_that_agree_on_every_deployment_scene_share_a_class():
     assert classes[0] == classes[1] != classes[2]
 
 
-def _rounds(config: LangConfig, seed: int = 3) -> list[tuple]:
+def _rounds(config: LangConfig, seed: int = 3, intention: str = "dev-warm-on-cool") -> list[tuple]:
     learner = LangLearner("stop", rng=seed, config=config)
-    intention = resolve("dev-warm-on-cool")
+    intention = resolve(intention)
     user = SimulatedUser(intention, "stop", user_profile("human"), rng=seed)
     seen: list[tuple] = []
 
@@ -171,9 +192,12 @@ def _rounds(config: LangConfig, seed: int = 3) -> list[tuple]:
 
 @pytest.mark.parametrize("switch", [{"scenes": "random"}, {"scenes": "needs"}, {"gain": "goal"}, {"gain": "shown"},
                                     {"gain": "shown-decision"}, {"needs": False}, {"chains": 4},
-                                    {"split": 3}])
+                                    {"split": 3}, {"needs_counts": True}])
 def test_every_switch_changes_the_questions(switch):
-    assert _rounds(LangConfig(**{**DECIDE, **switch})) != _rounds(LangConfig(**DECIDE))
+    # the count literals matter once a scene is refused for want of two cool blocks (seed 0)
+    seed, intention = (0, "truth-06") if "needs_counts" in switch else (3, "dev-warm-on-cool")
+    assert (_rounds(LangConfig(**{**DECIDE, **switch}), seed, intention)
+            != _rounds(LangConfig(**DECIDE), seed, intention))
 
 
 def test_decide_records_what_each_answer_taught():

@@ -77,6 +77,8 @@ class BayesConfig(BaseModel):
     deploy_scenes: int = Field(8, ge=1, description="gain = decision: the learner's own scenes of the test distribution")
     needs: bool = Field(False, description="also learn what the intention needs of a scene's objects from "
                         "'new scene' answers (needs.py)")
+    needs_counts: bool = Field(False, description="the needs belief also has literals counting the blocks a "
+                               "selector of the goal language picks ('at least two cool blocks', needs.py)")
     chains: int = Field(0, ge=0, description="stop queries: also offer plans of one of this many likely z "
                         "followed by another's (candidates.chained_plans); 0: none")
     split: int = Field(0, ge=0, description="stop queries: also offer this many plans grown step by step so "
@@ -137,7 +139,7 @@ class BayesLearner(Learner):
         self.prior_entropy = self.belief.entropy_bits()
         self._drained = 0
         self._classes: tuple[tuple[int, int], np.ndarray] | None = None
-        self.needs = Needs(self.config.new_scene_error) if self.config.needs else None
+        self.needs = Needs(self.config.new_scene_error, self.config.needs_counts) if self.config.needs else None
         self.deploy = (deployment_states(int(self.rng.integers(2**31)), self.config.deploy_scenes)
                        if self.config.gain.endswith("decision") else [])
 

@@ -5,7 +5,9 @@ no goal of the space states ("every block must have a rainbow colour", "at least
 Beside the belief over z the learner keeps a belief v over requirements R on the object set:
 conjunctions of at most ``MAX_LITERALS`` literals (``LITERALS``: at least 3 / 4 blocks, at least
 2 / 3 bowls, a block of colour c, no block of colour c, a bowl of colour c, every block's own
-bowl, a warm / cool block, no warm / cool block). Prior from description length: the number of literals k is geometric, P(k) ∝ 2^-(k+1),
+bowl, a warm / cool block, no warm / cool block; with ``counts``, also for every selector of the
+goal language "at least 1 / 2 blocks it picks", where that says something the others do not, such
+as "two cool blocks"). Prior from description length: the number of literals k is geometric, P(k) ∝ 2^-(k+1),
 and the k literals are uniform among the sets of that size.
 
 Mean-field answer model (z and R independent): with ε the assumed error of a "new scene" answer,
@@ -21,18 +23,21 @@ m = Σ_z w_z 1[z can be shown in s] and q(s) = Σ_R v_R 1[R fails on s],
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 
 import numpy as np
 
+from activeintent.goals.language import NODES
+from activeintent.learners.bayes.hypotheses import random_scene
 from activeintent.world import COLOR_NAMES, WARM_COLORS, Scene
 from activeintent.world.scene import color_of, kind_of
 
 MAX_LITERALS = 3
 
 
-def _literals() -> list[tuple[str, object]]:
+def _base_literals() -> list[tuple[str, object]]:
     out: list[tuple[str, object]] = [("blocks>=", 3), ("blocks>=", 4), ("bowls>=", 2), ("bowls>=", 3)]
     out += [("block", c) for c in COLOR_NAMES] + [("no-block", c) for c in COLOR_NAMES]
     out += [("bowl", c) for c in COLOR_NAMES] + [("own-bowls", None)]
@@ -40,44 +45,75 @@ def _literals() -> list[tuple[str, object]]:
     return out
 
 
-LITERALS = _literals()
-
-
-def literal_truth(objects: tuple[str, ...]) -> np.ndarray:
-    """Which literals hold for a scene of these objects."""
-    blocks = {color_of(o) for o in objects if kind_of(o) == "block"}
-    classes = {"warm" if c in WARM_COLORS else "cool" for c in blocks}
-    bowls = {color_of(o) for o in objects if kind_of(o) == "bowl"}
-    n_blocks = sum(kind_of(o) == "block" for o in objects)
-    n_bowls = sum(kind_of(o) == "bowl" for o in objects)
+def _truth(literals: list[tuple[str, object]], objects: tuple[str, ...]) -> np.ndarray:
+    blocks = [o for o in objects if kind_of(o) == "block"]
+    colours = {color_of(b) for b in blocks}
+    classes = {"warm" if c in WARM_COLORS else "cool" for c in colours}
+    bowls = tuple(o for o in objects if kind_of(o) == "bowl")
+    bowl_colours = {color_of(o) for o in bowls}
     out = []
-    for kind, arg in LITERALS:
+    for kind, arg in literals:
         if kind == "blocks>=":
-            out.append(n_blocks >= arg)
+            out.append(len(blocks) >= arg)  # type: ignore[operator]
         elif kind == "bowls>=":
-            out.append(n_bowls >= arg)
+            out.append(len(bowls) >= arg)  # type: ignore[operator]
         elif kind == "block":
-            out.append(arg in blocks)
+            out.append(arg in colours)
         elif kind == "no-block":
-            out.append(arg not in blocks)
+            out.append(arg not in colours)
         elif kind == "bowl":
-            out.append(arg in bowls)
+            out.append(arg in bowl_colours)
         elif kind == "class":
             out.append(arg in classes)
         elif kind == "no-class":
             out.append(arg not in classes)
+        elif kind == "picks>=":
+            sel, p, n = arg  # type: ignore[misc]
+            node = NODES["selector"][sel]
+            out.append(sum(node.pick(b, bowls, p) for b in blocks) >= n)
         else:
-            out.append(blocks <= bowls)
+            out.append(colours <= bowl_colours)
     return np.array(out, bool)
+
+
+@functools.cache
+def count_literals(bank: int = 400) -> tuple[tuple[str, object], ...]:
+    """"At least n blocks picked by selector (s, p)" for n = 1, 2 and every selector of the
+    language, each kept only if on a seeded bank of random scenes it is sometimes true, sometimes
+    false, and unlike every literal kept before it, base literals included (made on first use)."""
+    rng = np.random.default_rng(0)
+    scenes = [tuple(random_scene(rng).objects) for _ in range(bank)]
+    seen = {row.tobytes() for row in np.array([_truth(LITERALS, s) for s in scenes]).T}
+    out: list[tuple[str, object]] = []
+    for sel, node in NODES["selector"].items():
+        for p in node.params:
+            for n in (1, 2):
+                lit = ("picks>=", (sel, p, n))
+                row = np.array([_truth([lit], s)[0] for s in scenes])
+                if row.all() or not row.any() or row.tobytes() in seen:
+                    continue
+                seen.add(row.tobytes())
+                out.append(lit)
+    return tuple(out)
+
+
+LITERALS = _base_literals()
+
+
+def literal_truth(objects: tuple[str, ...], counts: bool = False) -> np.ndarray:
+    """Which literals hold for a scene of these objects (``counts``: the count literals too)."""
+    return _truth(LITERALS + list(count_literals()) if counts else LITERALS, objects)
 
 
 class Needs:
     """The belief v over requirements R (index sets of literals; the empty set: no requirement)."""
 
-    def __init__(self, new_scene_error: float):
+    def __init__(self, new_scene_error: float, counts: bool = False):
         self.error = new_scene_error
-        sets = [()] + [c for k in range(1, MAX_LITERALS + 1) for c in itertools.combinations(range(len(LITERALS)), k)]
-        n = len(LITERALS)
+        self.counts = counts
+        self.literals = LITERALS + list(count_literals()) if counts else LITERALS
+        n = len(self.literals)
+        sets = [()] + [c for k in range(1, MAX_LITERALS + 1) for c in itertools.combinations(range(n), k)]
         self.size = len(sets)
         self.index = np.full((self.size, MAX_LITERALS), n)  # n: a sentinel literal that always holds
         for i, s in enumerate(sets):
@@ -86,16 +122,19 @@ class Needs:
         log_p_k = -(k + 1) * math.log(2) - np.log([math.comb(n, int(j)) for j in k])
         self.log_v = log_p_k - np.logaddexp.reduce(log_p_k)
         self._fails: dict[tuple[str, ...], np.ndarray] = {}
+        self._weights: tuple[np.ndarray, np.ndarray] | None = None
 
     @property
     def weights(self) -> np.ndarray:
-        return np.exp(self.log_v - np.logaddexp.reduce(self.log_v))
+        if self._weights is None or self._weights[0] is not self.log_v:  # kept while log_v is: scene design asks often
+            self._weights = (self.log_v, np.exp(self.log_v - np.logaddexp.reduce(self.log_v)))
+        return self._weights[1]
 
     def fails(self, objects: tuple[str, ...]) -> np.ndarray:
         """Per R: does a scene of these objects fail it?"""
         got = self._fails.get(objects)
         if got is None:
-            truth = np.append(literal_truth(objects), True)
+            truth = np.append(literal_truth(objects, self.counts), True)
             got = self._fails[objects] = ~truth[self.index].all(axis=1)
         return got
 
@@ -115,7 +154,7 @@ class Needs:
         p_new = np.where(self.fails(tuple(objects)), 1 - e, p_new_ok)
         lik = p_new if new_scene else 1 - p_new
         self.log_v = self.log_v + np.log(np.clip(lik, 1e-300, None))
-        self.log_v -= np.logaddexp.reduce(self.log_v)
+        self.log_v = self.log_v - np.logaddexp.reduce(self.log_v)
 
     def top(self, n: int = 3) -> list[tuple[str, float]]:
         w = self.weights
@@ -123,9 +162,15 @@ class Needs:
         return [(self.describe(int(i)), round(float(w[i]), 4)) for i in order]
 
     def describe(self, i: int) -> str:
-        lits = [LITERALS[j] for j in self.index[i] if j < len(LITERALS)]
-        return " & ".join(f"{k}{a}" if k.endswith("=") else k if a is None else f"{k}:{a}"
-                          for k, a in lits) or "nothing"
+        lits = [self.literals[j] for j in self.index[i] if j < len(self.literals)]
+        return " & ".join(_word(k, a) for k, a in lits) or "nothing"
+
+
+def _word(kind: str, arg: object) -> str:
+    if kind == "picks>=":
+        sel, p, n = arg  # type: ignore[misc]
+        return f"{n}+ {sel}:{p}"
+    return f"{kind}{arg}" if kind.endswith("=") else kind if arg is None else f"{kind}:{arg}"
 
 
 def p_new_scene(feasible: np.ndarray, error: float, refuse: float = 0.0) -> np.ndarray:
