@@ -24,7 +24,9 @@
 - ``decide-keep10000-<signal>`` (a variant): the belief starts from the 10,000 shortest goals of the
   language instead of ``learner.KEEP`` = 3,000 (the cut rises from 15.8 to 17.9 bits);
 - ``decide-counts-<signal>`` (a variant): the needs belief also has literals that count the blocks a
-  selector of the language picks ("at least two cool blocks"; ``BayesConfig.needs_counts``).
+  selector of the language picks ("at least two cool blocks"; ``BayesConfig.needs_counts``);
+- ``decide-pool-<signal>`` (a variant): after each answer the 50 one-clause goals above the start
+  cut with the largest prior × likelihood join the belief (``LangConfig.pool``).
 """
 
 from activeintent.learners.lang.learner import DECIDE, KEEP, LangConfig, LangLearner
@@ -43,8 +45,9 @@ ABLATIONS = {
     "wide": {"n_scenes": 8, "scene_candidates": 32, "max_plans": 64, "top_k": 32},
     "keep10000": {"keep": 10000},  # not a LangConfig field: the goals the belief starts from
     "counts": {"needs_counts": True},
+    "pool": {"pool": 50},
 }
-VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000", "counts")
+VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000", "counts", "pool")
 
 
 def _ablation(part: str, signal: str) -> Method:

@@ -256,3 +256,20 @@ def test_a_split_plan_tells_the_likely_goals_apart_better_than_any_goals_own_pla
         assert split and all(len(o.plan) >= 2 for o in split)
         better += max(map(bits, split)) > max(map(bits, singles)) + 0.2
     assert better == 3
+
+
+def test_the_pool_brings_in_a_one_clause_goal_the_neighbours_do_not_reach():
+    """truth-11 ("every block behind the orange block, the others stay", 16.3 bits, above the
+    start cut): with exact answers it joins the belief within three answers from the pool of
+    one-clause goals, and not without the pool."""
+    intention = resolve("truth-11")
+    key = intention.goal.key
+    held = []
+    for pool in (50, 0):
+        learner = LangLearner("stop", rng=1, config=LangConfig(**{**DECIDE, "pool": pool}))
+        assert learner.mass_of(key) == 0  # not in the start space
+        user = SimulatedUser(intention, "stop", user_profile("exact"), rng=1)
+        Episode(learner, intention, user, make_executor("plan"), SymbolicEnv(),
+                ProtocolConfig(budget=3, seed=618006031, test_scenes=1, test_pool=0, curve=False)).run()
+        held.append(learner.mass_of(key))
+    assert held[0] > 0 and held[1] == 0

@@ -22,7 +22,12 @@ from activeintent.learners.base import LearnerContext, Method, RoundRecord
 from activeintent.learners.bayes.candidates import predict
 from activeintent.learners.bayes.judge import HypothesisJudge, trajectory_steps, utility
 from activeintent.learners.bayes.learner import BayesConfig, BayesLearner
-from activeintent.learners.lang.hypotheses import LangHypothesis, LangSpace, lang_space
+from activeintent.learners.lang.hypotheses import (
+    LangHypothesis,
+    LangSpace,
+    lang_space,
+    one_clause_pool,
+)
 from activeintent.learners.lang.proposals import neighbours, propose_goals
 from activeintent.llm.base import ModelError
 from activeintent.world import WorldState
@@ -95,6 +100,9 @@ class LangConfig(BayesConfig):
     proposals_per_call: int = Field(3, ge=1, le=5, description="goals asked of the model per call")
     final_joint: int = Field(0, ge=0, le=8, description="the final answer may also run a plan for both "
                              "goals of any pair of this many likely goals (0: off): one plan can satisfy two z")
+    pool: int = Field(0, ge=0, description="after each answer, this many one-clause goals longer than the "
+                      "start space's join: those with the largest prior × likelihood of every answer so far "
+                      "among all one-clause goals of the language (0: off)")
 
 
 class LangLearner(BayesLearner):
@@ -120,6 +128,12 @@ class LangLearner(BayesLearner):
         self.cut = max(h.bits for h in hyps) + 1e-9  # the starting space holds every distinct goal up to here
         self.growth = {"neighbours": 0, "model_answers": 0, "model_fit": 0, "model_new": 0}
         self.model_goals: set[str] = set()
+        if config.pool:  # every one-clause goal above the cut, scored on each answer as it comes
+            self.pool = one_clause_pool(self.cut)
+            self.pool.reset()
+            self.pool_judge = LangJudge(self.pool)
+            self.pool_log_post = -np.array([g.bits for g in self.pool.goals]) * np.log(2)  # up to a constant
+            self.growth["pool"] = 0
 
     # ---- growing the space ----
 
@@ -171,12 +185,26 @@ class LangLearner(BayesLearner):
         self.growth["model_new"] += len(added)
         return added
 
+    def _from_pool(self) -> int:
+        """The ``pool`` one-clause goals with the largest prior × likelihood join (those held
+        already are skipped by _admit)."""
+        lik = self._likelihood(self.observations[-1], self.pool_judge.hyps, self.pool_judge)
+        self.pool_log_post = self.pool_log_post + np.log(np.clip(lik, 1e-300, None))
+        best = ranking.order(self.pool_log_post)[:self.config.pool]
+        added = self._admit([self.pool.goals[i] for i in best])
+        self.growth["pool"] += len(added)
+        return len(added)
+
     def observe(self, record: RoundRecord, trajectories: list[Trajectory]) -> str | None:
         out = super().observe(record, trajectories)  # Bayes' rule, then model proposals (if any)
         if record.answer is not None:
             n = self._rejuvenate()
             if self.log:
                 self.log[-1]["neighbours_added"] = n
+            if self.config.pool:
+                pooled = self._from_pool()
+                if self.log:
+                    self.log[-1]["pool_added"] = pooled
         return out
 
     def final_outcomes(self, state: WorldState, w: np.ndarray, feasible: np.ndarray) -> list:
