@@ -76,13 +76,16 @@ def _truth(literals: list[tuple[str, object]], objects: tuple[str, ...]) -> np.n
     return np.array(out, bool)
 
 
+_COUNT_BANK = 400  # seeded scenes on which a count literal must vary and differ from the others
+
+
 @functools.cache
-def count_literals(bank: int = 400) -> tuple[tuple[str, object], ...]:
+def count_literals() -> tuple[tuple[str, object], ...]:
     """"At least n blocks picked by selector (s, p)" for n = 1, 2 and every selector of the
     language, each kept only if on a seeded bank of random scenes it is sometimes true, sometimes
     false, and unlike every literal kept before it, base literals included (made on first use)."""
     rng = np.random.default_rng(0)
-    scenes = [tuple(random_scene(rng).objects) for _ in range(bank)]
+    scenes = [tuple(random_scene(rng).objects) for _ in range(_COUNT_BANK)]
     seen = {row.tobytes() for row in np.array([_truth(LITERALS, s) for s in scenes]).T}
     out: list[tuple[str, object]] = []
     for sel, node in NODES["selector"].items():
@@ -98,11 +101,6 @@ def count_literals(bank: int = 400) -> tuple[tuple[str, object], ...]:
 
 
 LITERALS = _base_literals()
-
-
-def literal_truth(objects: tuple[str, ...], counts: bool = False) -> np.ndarray:
-    """Which literals hold for a scene of these objects (``counts``: the count literals too)."""
-    return _truth(LITERALS + list(count_literals()) if counts else LITERALS, objects)
 
 
 class Needs:
@@ -134,7 +132,7 @@ class Needs:
         """Per R: does a scene of these objects fail it?"""
         got = self._fails.get(objects)
         if got is None:
-            truth = np.append(literal_truth(objects, self.counts), True)
+            truth = np.append(_truth(self.literals, objects), True)
             got = self._fails[objects] = ~truth[self.index].all(axis=1)
         return got
 
