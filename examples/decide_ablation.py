@@ -26,7 +26,9 @@
 - ``decide-counts-<signal>`` (a variant): the needs belief also has literals that count the blocks a
   selector of the language picks ("at least two cool blocks"; ``BayesConfig.needs_counts``);
 - ``decide-pool-<signal>`` (a variant): after each answer the 50 one-clause goals above the start
-  cut with the largest prior × likelihood join the belief (``LangConfig.pool``).
+  cut with the largest prior × likelihood join the belief (``LangConfig.pool``);
+- ``decide-look-<signal>`` (a variant): two-step lookahead, a query valued by what its answer and
+  the best next query of the round tell together (``BayesConfig.lookahead = 2``).
 """
 
 from activeintent.learners.lang.learner import DECIDE, KEEP, LangConfig, LangLearner
@@ -46,8 +48,9 @@ ABLATIONS = {
     "keep10000": {"keep": 10000},  # not a LangConfig field: the goals the belief starts from
     "counts": {"needs_counts": True},
     "pool": {"pool": 50},
+    "look": {"lookahead": 2},
 }
-VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000", "counts", "pool")
+VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000", "counts", "pool", "look")
 
 
 def _ablation(part: str, signal: str) -> Method:

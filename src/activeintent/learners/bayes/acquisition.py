@@ -12,6 +12,11 @@ keeps only the second, P(f = 0) · EIG over the belief restricted to the z the s
 ``gain="decision"`` scores the information about the decision class of z instead
 (decision.py: z grouped by which plans satisfy them on scenes the robot will meet);
 ``gain="shown-decision"`` only what the shown trajectories tell about it, P(f = 0) · I(h; c | f = 0).
+
+Two-step lookahead (``BayesConfig.lookahead = 2``): a query is valued by what it and the best
+next query tell together, I(h₁; c) + Σ_{h₁} P(h₁) max_{q₂} I(h₂; c | h₁), with q₂ among every
+candidate query of the round (:func:`two_step`): a question that sets up a decisive next one
+can beat the one that is best alone.
 """
 
 from __future__ import annotations
@@ -71,6 +76,72 @@ def particles(weights: np.ndarray, mass: float = 1 - 1e-4, cap: int = 4000) -> n
     return np.sort(top[:min(n, cap)])
 
 
+LOOK_FIRST = 16  # the best one-step queries that get the two-step value
+
+
+def look_particles(weights: np.ndarray) -> np.ndarray:
+    """The particles of the two-step lookahead: the likeliest z holding 99 % (at most 256)."""
+    return particles(weights, mass=0.99, cap=256)
+
+
+@dataclass
+class Scored:
+    """Every candidate query of one state, kept for the two-step lookahead: per query its outcomes,
+    its one-step gain and P(h | z, q) ("new scene" included) over :func:`look_particles`."""
+
+    outs: list[Outcome]
+    combos: list[tuple[int, ...]]
+    gains: np.ndarray
+    tables: list[np.ndarray]
+
+
+def _information_many(w: np.ndarray, pool: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    """I(h; c) in nats for every query of ``pool`` [Z, Q, O] (z sorted by class, a class's first
+    row at ``starts``) under weights ``w`` [Z]: H[P(h)] − Σ_c W_c H[P(h | c)]."""
+    joint = np.add.reduceat(w[:, None, None] * pool, starts, axis=0)  # [C, Q, O]: W_c P(h | c)
+    mass = np.add.reduceat(w, starts)[:, None, None]
+    marginal = joint.sum(axis=0)
+    h_marg = -(marginal * np.log(np.clip(marginal, 1e-300, None))).sum(axis=1)
+    cond = np.where(joint > 0, joint / np.clip(mass, 1e-300, None), 1.0)
+    return h_marg + (joint * np.log(cond)).sum(axis=(0, 2))
+
+
+def stack_tables(tables: list[np.ndarray]) -> np.ndarray:
+    """[Z, Q, O]: the queries' P(h | z) side by side, answers padded with P = 0."""
+    width = max(t.shape[1] for t in tables)
+    pool = np.zeros((tables[0].shape[0], len(tables), width))
+    for q, t in enumerate(tables):
+        pool[:, q, :t.shape[1]] = t
+    return pool
+
+
+def two_step(scored: list[Scored], pool: np.ndarray, weights: np.ndarray, classes: np.ndarray,
+             first: int = LOOK_FIRST) -> tuple[int, int, float]:
+    """(which Scored, which of its queries, value): among the ``first`` best one-step queries of
+    ``scored``, the one with the largest I(h₁; c) + Σ_{h₁} P(h₁) max_{q₂ ∈ pool} I(h₂; c | h₁).
+    ``weights`` and ``classes`` are over the look particles (the rows of the tables and pool)."""
+    order = np.argsort(classes, kind="stable")
+    starts = np.flatnonzero(np.r_[True, np.diff(classes[order]) != 0])
+    pool = pool[order]
+    w = weights / weights.sum()
+    ws = w[order]
+    flat = [(i, j, float(g)) for i, sc in enumerate(scored) for j, g in enumerate(sc.gains)]
+    keys = np.array([g for _, _, g in flat])
+    best: tuple[int, int, float] | None = None
+    for n in ranking.order(keys)[:first]:
+        i, j, _ = flat[n]
+        table = scored[i].tables[j][order]
+        p_h = ws @ table
+        value = float(_information_many(ws, table[:, None, :], starts)[0])
+        for a in np.flatnonzero(p_h > 1e-9):
+            post = ws * table[:, a] / p_h[a]
+            value += float(p_h[a]) * float(_information_many(post, pool, starts).max())
+        value -= 1e-4 * sum(len(scored[i].outs[k].plan) for k in scored[i].combos[j])  # as select_query
+        if best is None or ranking.greater(value, best[2]):
+            best = (i, j, value)
+    return best  # type: ignore[return-value]
+
+
 @dataclass
 class Query:
     """The trajectories to show (as plans) and why: the EIG of this query and the best others."""
@@ -99,10 +170,12 @@ def select_query(
     gain: str = "goal",
     classes: np.ndarray | None = None,
     refuse: float = 0.0,
+    scored: list[Scored] | None = None,
 ) -> Query | None:
     """The query (``signal.shows`` distinct outcomes) with the largest EIG; ``choose="random"``
     picks uniformly among the candidates instead (same planner, same belief update). EIG is
-    computed over the ``cap`` most probable hypotheses when H is larger (see :func:`particles`)."""
+    computed over the ``cap`` most probable hypotheses when H is larger (see :func:`particles`).
+    ``scored``: also append every candidate's table for :func:`two_step`."""
     combos = list(itertools.combinations(range(len(outs)), signal.shows))
     if not combos:
         return None
@@ -116,8 +189,11 @@ def select_query(
         raise ValueError(f"unknown gain {gain!r}; valid gains: {', '.join(GAINS)}")
     if gain.endswith("decision") and classes is None:
         raise ValueError("gain='decision' needs the hypotheses' decision classes")
+    look = look_particles(weights) if scored is not None else None
     if len(weights) > cap:
         idx = particles(weights, cap=cap)
+        if look is not None:
+            look = np.searchsorted(idx, look)  # the look particles are the likeliest: all in idx
         judge, feasible = JudgeView(judge, idx), feasible[idx]  # type: ignore[assignment]
         weights = weights[idx] / weights[idx].sum()
         if classes is not None:
@@ -127,6 +203,7 @@ def select_query(
         p_shown = float(weights @ p_answer)
         w_shown = weights * p_answer / p_shown
     gains = np.empty(len(combos))
+    tables: list[np.ndarray] = []
     predicted = signal.predictive_many([[outs[i].traj for i in combo] for combo in combos], judge, model)
     for n, (combo, probs) in enumerate(zip(combos, predicted, strict=True)):
         if gain == "shown":
@@ -137,8 +214,12 @@ def select_query(
             g = class_information(weights, with_new_scene(probs, feasible, new_scene_error, refuse), classes)  # type: ignore[arg-type]
         else:
             g = eig(weights, with_new_scene(probs, feasible, new_scene_error, refuse))
+        if look is not None:
+            tables.append(with_new_scene(probs[look], feasible[look], new_scene_error, refuse))
         # Among (near-)equal gains prefer short plans: they are quicker to watch.
         gains[n] = g - 1e-4 * sum(len(outs[i].plan) for i in combo)
+    if scored is not None:
+        scored.append(Scored(outs, combos, gains, tables))
     order = ranking.order(gains)
     best = combos[order[0]]
     alternatives = [

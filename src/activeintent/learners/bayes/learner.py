@@ -27,7 +27,15 @@ from pydantic import BaseModel, Field
 from activeintent import ranking
 from activeintent.goals.facts import facts
 from activeintent.learners.base import Estimate, Learner, RoundRecord
-from activeintent.learners.bayes.acquisition import Query, particles, select_query
+from activeintent.learners.bayes.acquisition import (
+    Query,
+    Scored,
+    look_particles,
+    particles,
+    select_query,
+    stack_tables,
+    two_step,
+)
 from activeintent.learners.bayes.belief import Belief, Prior
 from activeintent.learners.bayes.candidates import (
     candidate_plans,
@@ -83,6 +91,8 @@ class BayesConfig(BaseModel):
                         "followed by another's (candidates.chained_plans); 0: none")
     split: int = Field(0, ge=0, description="stop queries: also offer this many plans grown step by step so "
                        "that each step moves away from about half of the likely z left (candidates.split_plans); 0: none")
+    lookahead: int = Field(1, ge=1, le=2, description="1: the query whose answer tells most; 2: the one whose "
+                           "answer and the best next query's tell most together (acquisition.two_step)")
     top_k: int = Field(16, ge=1, description="plans come from this many most probable hypotheses")
     explore: int = Field(6, ge=0, description="... plus this many random other hypotheses")
     max_plans: int = Field(36, ge=2, description="candidate plans per scene")
@@ -139,6 +149,7 @@ class BayesLearner(Learner):
         self.prior_entropy = self.belief.entropy_bits()
         self._drained = 0
         self._classes: tuple[tuple[int, int], np.ndarray] | None = None
+        self._look_pool: tuple[bytes, list[np.ndarray]] | None = None  # this round's query tables (lookahead)
         self.needs = Needs(self.config.new_scene_error, self.config.needs_counts) if self.config.needs else None
         self.deploy = (deployment_states(int(self.rng.integers(2**31)), self.config.deploy_scenes)
                        if self.config.gain.endswith("decision") else [])
@@ -186,7 +197,7 @@ class BayesLearner(Learner):
 
     # ---- queries ----
 
-    def _select(self, state: WorldState) -> Query | None:
+    def _select(self, state: WorldState, scored: list[Scored] | None = None) -> Query | None:
         c = self.config
         feasible = self.judge.feasible(tuple(state.positions))
         outs = candidate_plans(self.hyps, self.weights, state, self.rng, top_k=c.top_k, explore=c.explore,
@@ -205,7 +216,20 @@ class BayesLearner(Learner):
         return select_query(self.sig, self.model, self.judge, self.weights, feasible, outs,
                             c.new_scene_error, self.rng, choose=c.choose, gain=c.gain,
                             classes=self.decision_classes() if c.gain.endswith("decision") else None,
-                            refuse=self.refuse(tuple(state.positions)))
+                            refuse=self.refuse(tuple(state.positions)), scored=scored)
+
+    def _looking(self) -> bool:
+        return self.config.lookahead == 2 and self.config.choose == "eig"
+
+    def _two_step(self, scored: list[Scored], pool: list[np.ndarray]) -> tuple[int, Query]:
+        """The two-step lookahead's choice among ``scored`` against the query ``pool`` (acquisition.two_step)."""
+        look = look_particles(self.weights)
+        classes = self.decision_classes()[look] if self.config.gain.endswith("decision") else np.arange(len(look))
+        i, j, value = two_step(scored, stack_tables(pool), self.weights[look], classes)
+        sc = scored[i]
+        alternatives = [{"plans": [describe_plan(sc.outs[k].plan) for k in sc.combos[j]], "lookahead_nats": round(value, 4),
+                         "note": "chosen by the two-step value; eig_nats is its one-step gain"}]
+        return i, Query([sc.outs[k] for k in sc.combos[j]], float(sc.gains[j]), alternatives)
 
     def refuse(self, objects: tuple[str, ...]) -> float:
         """q(s): P(the scene lacks what the intention needs) under the needs belief (0 without one)."""
@@ -259,15 +283,29 @@ class BayesLearner(Learner):
         the largest information gain (``scenes = belief``: among those the belief most expects
         to be able to show its goals)."""
         best: tuple[Scene, Query] | None = None
+        looked: list[tuple[Scene, Scored]] = []
         for scene in self._scene_candidates():
-            q = self._select(WorldState(positions=layout(scene, int(self.rng.integers(2**31)))))
+            scored: list[Scored] | None = [] if self._looking() else None
+            q = self._select(WorldState(positions=layout(scene, int(self.rng.integers(2**31)))), scored)
+            if scored:
+                looked.append((scene, scored[0]))
             if q is not None and (best is None or ranking.greater(q.gain, best[1].gain)):
                 best = (scene, q)
+        if looked:  # lookahead: the next query may come from any scene of this round
+            pool = [t for _, sc in looked for t in sc.tables]
+            self._look_pool = (look_particles(self.weights).tobytes(), pool)
+            i, q = self._two_step([sc for _, sc in looked], pool)
+            best = (looked[i][0], q)
         self.designed = best
         return best[0] if best else None
 
     def estimate(self, scene: Scene, state: WorldState) -> Estimate:
-        q = self._select(state)  # the real layout: re-select for it
+        scored: list[Scored] | None = [] if self._looking() else None
+        q = self._select(state, scored)  # the real layout: re-select for it
+        if scored:  # lookahead: against this layout's queries and those of the round's design
+            kept = self._look_pool
+            design = kept[1] if kept is not None and kept[0] == look_particles(self.weights).tobytes() else []
+            q = self._two_step(scored, scored[0].tables + design)[1]
         top, w = self.top()[0]
         if q is None:
             plan = top.plan(state) or []
@@ -306,6 +344,7 @@ class BayesLearner(Learner):
                  if self.sig.shows > 1 else
                  [f"step {s.index + 1}: {describe_skill(s.skill)}" for t in trajectories for s in t.steps])
         obs = Observation(record.scene, answer, list(trajectories), texts, self.refuse(tuple(record.scene.objects)))
+        self._look_pool = None  # the round is over: its queries are not the next round's
         lik = self._likelihood(obs, self.hyps, self.judge)
         before = self.weights
         shown = self.shown_mass(record.scene)
