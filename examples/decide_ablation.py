@@ -28,7 +28,10 @@
 - ``decide-pool-<signal>`` (a variant): after each answer the 50 one-clause goals above the start
   cut with the largest prior × likelihood join the belief (``LangConfig.pool``);
 - ``decide-look-<signal>`` (a variant): two-step lookahead, a query valued by what its answer and
-  the best next query of the round tell together (``BayesConfig.lookahead = 2``).
+  the best next query of the round tell together (``BayesConfig.lookahead = 2``);
+- ``decide-value-<signal>`` (a variant): queries scored by the expected success of the final
+  answer on the learner's deployment scenes after the answer (``gain = "value"``), not by
+  information about the decision classes.
 """
 
 from activeintent.learners.lang.learner import DECIDE, KEEP, LangConfig, LangLearner
@@ -49,8 +52,9 @@ ABLATIONS = {
     "counts": {"needs_counts": True},
     "pool": {"pool": 50},
     "look": {"lookahead": 2},
+    "value": {"gain": "value"},
 }
-VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000", "counts", "pool", "look")
+VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000", "counts", "pool", "look", "value")
 
 
 def _ablation(part: str, signal: str) -> Method:

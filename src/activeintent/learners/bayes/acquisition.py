@@ -12,6 +12,8 @@ keeps only the second, P(f = 0) · EIG over the belief restricted to the z the s
 ``gain="decision"`` scores the information about the decision class of z instead
 (decision.py: z grouped by which plans satisfy them on scenes the robot will meet);
 ``gain="shown-decision"`` only what the shown trajectories tell about it, P(f = 0) · I(h; c | f = 0).
+``gain="value"`` scores the expected success of the final decision after the answer
+(decision.decision_value), ties broken by I(h; c).
 
 Two-step lookahead (``BayesConfig.lookahead = 2``): a query is valued by what it and the best
 next query tell together, I(h₁; c) + Σ_{h₁} P(h₁) max_{q₂} I(h₂; c | h₁), with q₂ among every
@@ -29,12 +31,13 @@ from pydantic import BaseModel
 
 from activeintent import ranking
 from activeintent.learners.bayes.candidates import Outcome
-from activeintent.learners.bayes.decision import class_information
+from activeintent.learners.bayes.decision import DecisionTable, class_information, decision_value
 from activeintent.learners.bayes.needs import p_new_scene
 from activeintent.signals import Judge, Signal
 from activeintent.world import describe_plan
 
-GAINS = ("goal", "shown", "decision", "shown-decision")
+GAINS = ("goal", "shown", "decision", "shown-decision", "value")
+VALUE_TIE = 1e-4  # gain = "value": among queries of (near-)equal value, the one that tells more about c
 
 
 def _entropy(p: np.ndarray) -> np.ndarray:
@@ -171,6 +174,7 @@ def select_query(
     classes: np.ndarray | None = None,
     refuse: float = 0.0,
     scored: list[Scored] | None = None,
+    table: DecisionTable | None = None,
 ) -> Query | None:
     """The query (``signal.shows`` distinct outcomes) with the largest EIG; ``choose="random"``
     picks uniformly among the candidates instead (same planner, same belief update). EIG is
@@ -187,8 +191,10 @@ def select_query(
         return Query([outs[i] for i in pick], float("nan"))
     if gain not in GAINS:
         raise ValueError(f"unknown gain {gain!r}; valid gains: {', '.join(GAINS)}")
-    if gain.endswith("decision") and classes is None:
-        raise ValueError("gain='decision' needs the hypotheses' decision classes")
+    if (gain.endswith("decision") or gain == "value") and classes is None:
+        raise ValueError(f"gain={gain!r} needs the hypotheses' decision classes")
+    if gain == "value" and table is None:
+        raise ValueError("gain='value' needs the decision table of the deployment scenes")
     look = look_particles(weights) if scored is not None else None
     if len(weights) > cap:
         idx = particles(weights, cap=cap)
@@ -198,6 +204,8 @@ def select_query(
         weights = weights[idx] / weights[idx].sum()
         if classes is not None:
             classes = np.unique(classes[idx], return_inverse=True)[1].reshape(-1)
+        if table is not None:
+            table = table.take(idx)
     if gain.startswith("shown"):
         p_answer = 1 - p_new_scene(feasible, new_scene_error, refuse)
         p_shown = float(weights @ p_answer)
@@ -212,6 +220,9 @@ def select_query(
             g = p_shown * class_information(w_shown, probs, classes)  # type: ignore[arg-type]
         elif gain == "decision":
             g = class_information(weights, with_new_scene(probs, feasible, new_scene_error, refuse), classes)  # type: ignore[arg-type]
+        elif gain == "value":
+            full = with_new_scene(probs, feasible, new_scene_error, refuse)
+            g = decision_value(weights, full, table) + VALUE_TIE * class_information(weights, full, classes)  # type: ignore[arg-type]
         else:
             g = eig(weights, with_new_scene(probs, feasible, new_scene_error, refuse))
         if look is not None:

@@ -43,7 +43,12 @@ from activeintent.learners.bayes.candidates import (
     predict,
     split_plans,
 )
-from activeintent.learners.bayes.decision import decision_classes, deployment_states
+from activeintent.learners.bayes.decision import (
+    DecisionTable,
+    classes_of,
+    decision_table,
+    deployment_states,
+)
 from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space, random_scene
 from activeintent.learners.bayes.judge import HypothesisJudge
 from activeintent.learners.bayes.needs import Needs, p_answered, p_new_scene
@@ -77,11 +82,12 @@ class BayesConfig(BaseModel):
         "ones that the belief most expects to show its goals, also after a 'new scene' answer; needs: as belief, "
         "each candidate drawn to also meet a requirement drawn from the needs belief")
     scene_candidates: int = Field(16, ge=1, description="scenes drawn per design_scene when scenes = belief")
-    gain: Literal["goal", "shown", "decision", "shown-decision"] = Field(
+    gain: Literal["goal", "shown", "decision", "shown-decision", "value"] = Field(
         "goal", description="goal: EIG about z, the 'new scene' answer included; shown: only what the "
         "answers to the shown trajectories tell (the feasibility part of the EIG left out); decision: "
         "information about which plans to run on scenes of the public test distribution (decision.py); "
-        "shown-decision: only what the answers to the shown trajectories tell about that")
+        "shown-decision: only what the answers to the shown trajectories tell about that; value: the expected "
+        "success of the final answer on those scenes after the answer (decision.decision_value)")
     deploy_scenes: int = Field(8, ge=1, description="gain = decision: the learner's own scenes of the test distribution")
     needs: bool = Field(False, description="also learn what the intention needs of a scene's objects from "
                         "'new scene' answers (needs.py)")
@@ -148,11 +154,11 @@ class BayesLearner(Learner):
         self.answer_log: list[dict] = []  # diagnostics(): one entry per answer
         self.prior_entropy = self.belief.entropy_bits()
         self._drained = 0
-        self._classes: tuple[tuple[int, int], np.ndarray] | None = None
+        self._classes: tuple[tuple[int, int], np.ndarray, DecisionTable] | None = None
         self._look_pool: tuple[bytes, list[np.ndarray]] | None = None  # this round's query tables (lookahead)
         self.needs = Needs(self.config.new_scene_error, self.config.needs_counts) if self.config.needs else None
         self.deploy = (deployment_states(int(self.rng.integers(2**31)), self.config.deploy_scenes)
-                       if self.config.gain.endswith("decision") else [])
+                       if self._deciding() else [])
 
     @property
     def redesigns_after_new_scene(self) -> bool:  # type: ignore[override]
@@ -211,12 +217,13 @@ class BayesLearner(Learner):
             outs += split_plans(self.hyps, self.weights, state, feasible, self.judge,
                                 particles(self.weights, mass=0.99, cap=256), starts=c.split,
                                 seen={o.key for o in outs},
-                                classes=self.decision_classes() if c.gain.endswith("decision") else None)
+                                classes=self.decision_classes() if self._deciding() else None)
             feasible = self.judge.feasible(tuple(state.positions))
         return select_query(self.sig, self.model, self.judge, self.weights, feasible, outs,
                             c.new_scene_error, self.rng, choose=c.choose, gain=c.gain,
-                            classes=self.decision_classes() if c.gain.endswith("decision") else None,
-                            refuse=self.refuse(tuple(state.positions)), scored=scored)
+                            classes=self.decision_classes() if self._deciding() else None,
+                            refuse=self.refuse(tuple(state.positions)), scored=scored,
+                            table=self.decision_table() if c.gain == "value" else None)
 
     def _looking(self) -> bool:
         return self.config.lookahead == 2 and self.config.choose == "eig"
@@ -224,7 +231,7 @@ class BayesLearner(Learner):
     def _two_step(self, scored: list[Scored], pool: list[np.ndarray]) -> tuple[int, Query]:
         """The two-step lookahead's choice among ``scored`` against the query ``pool`` (acquisition.two_step)."""
         look = look_particles(self.weights)
-        classes = self.decision_classes()[look] if self.config.gain.endswith("decision") else np.arange(len(look))
+        classes = self.decision_classes()[look] if self._deciding() else np.arange(len(look))
         i, j, value = two_step(scored, stack_tables(pool), self.weights[look], classes)
         sc = scored[i]
         alternatives = [{"plans": [describe_plan(sc.outs[k].plan) for k in sc.combos[j]], "lookahead_nats": round(value, 4),
@@ -235,15 +242,26 @@ class BayesLearner(Learner):
         """q(s): P(the scene lacks what the intention needs) under the needs belief (0 without one)."""
         return 0.0 if self.needs is None else self.needs.refuse(objects)
 
+    def _deciding(self) -> bool:
+        return self.config.gain.endswith("decision") or self.config.gain == "value"
+
     def decision_classes(self) -> np.ndarray:
         """z grouped by the plans that satisfy them on the learner's deployment scenes (once per
         belief: the answers so far and the size of H key it)."""
+        return self._decision()[0]
+
+    def decision_table(self) -> DecisionTable:
+        """Which candidate plans satisfy each z on the learner's deployment scenes (decision.py)."""
+        return self._decision()[1]
+
+    def _decision(self) -> tuple[np.ndarray, DecisionTable]:
         key = (len(self.observations), len(self.hyps))
         if self._classes is None or self._classes[0] != key:
             rng = np.random.default_rng(list(key))  # not the learner's stream: a cache must not move it
-            self._classes = (key, decision_classes(self.hyps, self.weights, self.judge, self.deploy, rng,
-                                                   top_k=self.config.final_top_k, limit=self.config.max_plans))
-        return self._classes[1]
+            table = decision_table(self.hyps, self.weights, self.judge, self.deploy, rng,
+                                   top_k=self.config.final_top_k, limit=self.config.max_plans)
+            self._classes = (key, classes_of(table, len(self.hyps)), table)
+        return self._classes[1], self._classes[2]
 
     def shown_mass(self, scene: Scene) -> float:
         """Σ_z w_z 1[z can be shown in ``scene``]: the belief's chance that the user answers
