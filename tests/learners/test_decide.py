@@ -13,8 +13,10 @@ from activeintent.goals.language import parse_goal
 from activeintent.learners.bayes.acquisition import Scored, select_query, stack_tables, two_step
 from activeintent.learners.bayes.candidates import Outcome
 from activeintent.learners.bayes.decision import (
+    DecisionTable,
     class_information,
     decision_classes,
+    decision_value,
     deployment_states,
 )
 from activeintent.learners.lang.hypotheses import LangSpace
@@ -93,6 +95,27 @@ def test_the_decision_gain_prefers_the_query_that_separates_plans():
     assert q.outcomes[0].traj == "decides"
     with pytest.raises(ValueError, match="valid gains"):
         select_query(*args, gain="decisoin")
+
+
+def test_the_value_gain_is_the_expected_success_of_the_decision_after_the_answer():
+    """One deployment scene, plans "nothing" / p1 / p2: p1 satisfies z1 and z2, p2 satisfies z3.
+    Without an answer the robot runs p1 (0.9). An answer that tells {z1, z2} from z3 lets it run
+    the right plan always (1.0); one that tells z1 from z2 changes nothing (0.9)."""
+    w = np.array([0.45, 0.45, 0.1])
+    table = DecisionTable([np.ones(3, bool)], [np.array([[0, 1, 0], [0, 1, 0], [0, 0, 1]], bool)])
+    names = np.array([[1.0, 0.0], [0.0, 1.0], [0.5, 0.5]])
+    decides = np.array([[1.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    assert decision_value(w, np.ones((3, 1)), table) == pytest.approx(0.9)
+    assert decision_value(w, names, table) == pytest.approx(0.9)
+    assert decision_value(w, decides, table) == pytest.approx(1.0)
+    # a scene that cannot show z3: given that the scene shows z, p1 is right whatever the answer
+    shown_12 = DecisionTable([np.array([True, True, False])], [table.satisfied[0] & [[1], [1], [0]]])
+    assert decision_value(w, decides, shown_12) == pytest.approx(0.9)
+    tables = {"names": names, "decides": decides}
+    outs = [Outcome([], "names"), Outcome([], "decides")]  # type: ignore[arg-type]
+    q = select_query(_TableSignal(tables), None, None, w, np.ones(3, bool), outs, 0.1, np.random.default_rng(0),
+                     gain="value", classes=np.array([0, 0, 1]), table=table)
+    assert q.outcomes[0].traj == "decides"
 
 
 def test_the_shown_decision_gain_is_the_decision_gain_without_what_feasibility_tells():
@@ -192,7 +215,7 @@ def _rounds(config: LangConfig, seed: int = 3, intention: str = "dev-warm-on-coo
 
 @pytest.mark.parametrize("switch", [{"scenes": "random"}, {"scenes": "needs"}, {"gain": "goal"}, {"gain": "shown"},
                                     {"gain": "shown-decision"}, {"needs": False}, {"chains": 4},
-                                    {"split": 3}, {"needs_counts": True}, {"lookahead": 2}])
+                                    {"split": 3}, {"needs_counts": True}, {"lookahead": 2}, {"gain": "value"}])
 def test_every_switch_changes_the_questions(switch):
     # the count literals matter once a scene is refused for want of two cool blocks (seed 0)
     # (with seed 3 the lookahead's choice happens to be the one-step best in all three rounds)
