@@ -38,6 +38,7 @@ from activeintent.goals.facts import facts
 from activeintent.learners.bayes.acquisition import Query, Scored, look_particles
 from activeintent.learners.bayes.candidates import candidate_plans
 from activeintent.learners.lang.learner import DECIDE, LangConfig, LangLearner
+from activeintent.provenance import provenance
 from activeintent.spec import ProtocolConfig
 from activeintent.suites import resolve
 from activeintent.users.simulated import IntentionJudge, SimulatedUser, user_profile
@@ -113,8 +114,10 @@ def run_one(record: dict) -> dict:
     user = SimulatedUser(intention, "stop", user_profile("exact"), rng=seeds.user)
     learner = ClairvoyantChooser(intention, seeds.learner, POOL)
     res = Episode(learner, intention, user, make_executor("plan"), SymbolicEnv(), protocol).run()
-    return {"intention": record["intention"], "seed": record["seed"], "success_at": res.success_at,
-            "decide_stop": record["success_at"], "answers": res.answers}
+    return {"intention": record["intention"], "seed": record["seed"], "user_preset": "exact",
+            "budget": protocol.budget, "pool": POOL, "success_at": res.success_at,
+            "baseline": record["method"], "baseline_success_at": record["success_at"],
+            "answers": res.answers, "provenance": provenance()}
 
 
 def main() -> None:
@@ -139,11 +142,11 @@ def main() -> None:
                 fh.write(json.dumps(row) + "\n")
                 print(row["intention"], [round(x, 2) for x in row["success_at"]], flush=True)
     a = np.array([r["success_at"] for r in rows], float)
-    b = np.array([r["decide_stop"] for r in rows], float)
+    b = np.array([r["baseline_success_at"] for r in rows], float)
     d = a.mean(1) - b.mean(1)
     half = 1.96 * d.std(ddof=1) / np.sqrt(len(d))
     print(f"n = {len(rows)}: clairvoyant chooser success@5 {a[:, 5].mean():.2f}, @10 {a[:, 10].mean():.2f}; "
-          f"{method} {b[:, 5].mean():.2f} / {b[:, 10].mean():.2f}; "
+          f"{method} (the records') {b[:, 5].mean():.2f} / {b[:, 10].mean():.2f}; "
           f"area difference {d.mean():+.3f} [{d.mean() - half:+.3f}, {d.mean() + half:+.3f}]")
 
 
