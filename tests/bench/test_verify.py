@@ -20,7 +20,9 @@ FAST = {"paper"}  # re-run in the fast suite; every other bench folder is re-run
 NOT_BENCH = {"perf-lang": "benchmark timings (perf-bench JSON), not results",
              "web-wait": "the web study's waits (web-bench JSON), not results",
              "coverage": "coverage of the goal language (re-run by tests/bench/test_coverage.py)",
-             "redesign-equivalence": "its own replay scripts and README"}
+             "redesign-equivalence": "its own replay scripts and README",
+             "clairvoyant-bound": "a diagnostic's rows (examples/clairvoyant_bound.py reads the hidden intention), "
+                                  "not a method's results"}
 
 
 def bench_folders() -> list[str]:
