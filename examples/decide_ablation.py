@@ -26,7 +26,8 @@
 - ``decide-counts-<signal>`` (a variant): the needs belief also has literals that count the blocks a
   selector of the language picks ("at least two cool blocks"; ``BayesConfig.needs_counts``);
 - ``decide-pool-<signal>`` (a variant): after each answer the 50 one-clause goals above the start
-  cut with the largest prior × likelihood join the belief (``LangConfig.pool``);
+  cut with the largest prior × likelihood join the belief (``LangConfig.pool``); ``decide-pool500-<signal>``
+  the same with 500;
 - ``decide-look-<signal>`` (a variant): two-step lookahead, a query valued by what its answer and
   the best next query of the round tell together (``BayesConfig.lookahead = 2``);
 - ``decide-value-<signal>`` (a variant): queries scored by the expected success of the final
@@ -51,10 +52,11 @@ ABLATIONS = {
     "keep10000": {"keep": 10000},  # not a LangConfig field: the goals the belief starts from
     "counts": {"needs_counts": True},
     "pool": {"pool": 50},
+    "pool500": {"pool": 500},
     "look": {"lookahead": 2},
     "value": {"gain": "value"},
 }
-VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000", "counts", "pool", "look", "value")
+VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000", "counts", "pool", "pool500", "look", "value")
 
 
 def _ablation(part: str, signal: str) -> Method:
