@@ -38,6 +38,7 @@ from activeintent.world import describe_plan
 
 GAINS = ("goal", "shown", "decision", "shown-decision", "value")
 VALUE_TIE = 1e-4  # gain = "value": among queries of (near-)equal value, the one that tells more about c
+SHORT_PLANS = 1e-4  # per step shown: among (near-)equal gains prefer short plans, quicker to watch
 
 
 def _entropy(p: np.ndarray) -> np.ndarray:
@@ -139,7 +140,7 @@ def two_step(scored: list[Scored], pool: np.ndarray, weights: np.ndarray, classe
         for a in np.flatnonzero(p_h > 1e-9):
             post = ws * table[:, a] / p_h[a]
             value += float(p_h[a]) * float(_information_many(post, pool, starts).max())
-        value -= 1e-4 * sum(len(scored[i].outs[k].plan) for k in scored[i].combos[j])  # as select_query
+        value -= SHORT_PLANS * sum(len(scored[i].outs[k].plan) for k in scored[i].combos[j])
         if best is None or ranking.greater(value, best[2]):
             best = (i, j, value)
     return best  # type: ignore[return-value]
@@ -198,8 +199,10 @@ def select_query(
     look = look_particles(weights) if scored is not None else None
     if len(weights) > cap:
         idx = particles(weights, cap=cap)
-        if look is not None:
-            look = np.searchsorted(idx, look)  # the look particles are the likeliest: all in idx
+        if look is not None:  # the look particles are a prefix of the same ranking: all in idx
+            at = np.searchsorted(idx, look)
+            assert np.array_equal(idx[np.minimum(at, len(idx) - 1)], look), "look particles outside the EIG particles"
+            look = at
         judge, feasible = JudgeView(judge, idx), feasible[idx]  # type: ignore[assignment]
         weights = weights[idx] / weights[idx].sum()
         if classes is not None:
@@ -227,8 +230,7 @@ def select_query(
             g = eig(weights, with_new_scene(probs, feasible, new_scene_error, refuse))
         if look is not None:
             tables.append(with_new_scene(probs[look], feasible[look], new_scene_error, refuse))
-        # Among (near-)equal gains prefer short plans: they are quicker to watch.
-        gains[n] = g - 1e-4 * sum(len(outs[i].plan) for i in combo)
+        gains[n] = g - SHORT_PLANS * sum(len(outs[i].plan) for i in combo)
     if scored is not None:
         scored.append(Scored(outs, combos, gains, tables))
     order = ranking.order(gains)
