@@ -32,7 +32,8 @@
   the best next query of the round tell together (``BayesConfig.lookahead = 2``);
 - ``decide-value-<signal>`` (a variant): queries scored by the expected success of the final
   answer on the learner's deployment scenes after the answer (``gain = "value"``), not by
-  information about the decision classes.
+  information about the decision classes;
+- ``decide-deploy32-<signal>`` (a variant): decision classes from 32 deployment scenes instead of 8.
 """
 
 from activeintent.learners.lang.learner import DECIDE, KEEP, LangConfig, LangLearner
@@ -55,8 +56,9 @@ ABLATIONS = {
     "pool500": {"pool": 500},
     "look": {"lookahead": 2},
     "value": {"gain": "value"},
+    "deploy32": {"deploy_scenes": 32},
 }
-VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000", "counts", "pool", "pool500", "look", "value")
+VARIANTS = ("needs-scenes", "chains", "joint", "split", "wide", "keep10000", "counts", "pool", "pool500", "look", "value", "deploy32")
 
 
 def _ablation(part: str, signal: str) -> Method:
