@@ -217,19 +217,20 @@ def select_query(
     tables: list[np.ndarray] = []
     predicted = signal.predictive_many([[outs[i].traj for i in combo] for combo in combos], judge, model)
     for n, (combo, probs) in enumerate(zip(combos, predicted, strict=True)):
+        full = None if gain.startswith("shown") and look is None else with_new_scene(
+            probs, feasible, new_scene_error, refuse)  # P(h | z) with "new scene"
         if gain == "shown":
             g = p_shown * eig(w_shown, probs)
         elif gain == "shown-decision":
             g = p_shown * class_information(w_shown, probs, classes)  # type: ignore[arg-type]
         elif gain == "decision":
-            g = class_information(weights, with_new_scene(probs, feasible, new_scene_error, refuse), classes)  # type: ignore[arg-type]
+            g = class_information(weights, full, classes)  # type: ignore[arg-type]
         elif gain == "value":
-            full = with_new_scene(probs, feasible, new_scene_error, refuse)
             g = decision_value(weights, full, table) + VALUE_TIE * class_information(weights, full, classes)  # type: ignore[arg-type]
         else:
-            g = eig(weights, with_new_scene(probs, feasible, new_scene_error, refuse))
+            g = eig(weights, full)  # type: ignore[arg-type]
         if look is not None:
-            tables.append(with_new_scene(probs[look], feasible[look], new_scene_error, refuse))
+            tables.append(full[look])  # type: ignore[index]
         gains[n] = g - SHORT_PLANS * sum(len(outs[i].plan) for i in combo)
     if scored is not None:
         scored.append(Scored(outs, combos, gains, tables))

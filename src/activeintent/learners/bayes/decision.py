@@ -95,12 +95,12 @@ def decision_value(weights: np.ndarray, probs: np.ndarray, table: DecisionTable)
     if not table.feasible:
         return 0.0
     joint = weights[:, None] * probs  # [Z, O]: w_z P(h | z)
+    p_h = joint.sum(axis=0)
     total = 0.0
     for feasible, satisfied in zip(table.feasible, table.satisfied, strict=True):
         shown = joint * feasible[:, None]
         mass = shown.sum(axis=0)  # [O]: P(h, s shows z)
         best = (shown.T @ satisfied).max(axis=1)  # [O]: max_p P(h, p satisfies z)
-        p_h = joint.sum(axis=0)
         total += float((p_h * np.where(mass > 0, best / np.where(mass > 0, mass, 1.0), 0.0)).sum())
     return total / len(table.feasible)
 

@@ -155,7 +155,7 @@ class BayesLearner(Learner):
         self.prior_entropy = self.belief.entropy_bits()
         self._drained = 0
         self._classes: tuple[tuple[int, int], np.ndarray, DecisionTable] | None = None
-        self._look_pool: tuple[bytes, list[np.ndarray]] | None = None  # this round's query tables (lookahead)
+        self._look_pool: list[np.ndarray] = []  # this round's query tables (lookahead; cleared at each answer)
         self.needs = Needs(self.config.new_scene_error, self.config.needs_counts) if self.config.needs else None
         self.deploy = (deployment_states(int(self.rng.integers(2**31)), self.config.deploy_scenes)
                        if self._deciding() else [])
@@ -311,7 +311,7 @@ class BayesLearner(Learner):
                 best = (scene, q)
         if looked:  # lookahead: the next query may come from any scene of this round
             pool = [t for _, sc in looked for t in sc.tables]
-            self._look_pool = (look_particles(self.weights).tobytes(), pool)
+            self._look_pool = pool
             i, q = self._two_step([sc for _, sc in looked], pool)
             best = (looked[i][0], q)
         self.designed = best
@@ -321,9 +321,7 @@ class BayesLearner(Learner):
         scored: list[Scored] | None = [] if self._looking() else None
         q = self._select(state, scored)  # the real layout: re-select for it
         if scored:  # lookahead: against this layout's queries and those of the round's design
-            kept = self._look_pool
-            design = kept[1] if kept is not None and kept[0] == look_particles(self.weights).tobytes() else []
-            q = self._two_step(scored, scored[0].tables + design)[1]
+            q = self._two_step(scored, scored[0].tables + self._look_pool)[1]
         top, w = self.top()[0]
         if q is None:
             plan = top.plan(state) or []
@@ -362,7 +360,7 @@ class BayesLearner(Learner):
                  if self.sig.shows > 1 else
                  [f"step {s.index + 1}: {describe_skill(s.skill)}" for t in trajectories for s in t.steps])
         obs = Observation(record.scene, answer, list(trajectories), texts, self.refuse(tuple(record.scene.objects)))
-        self._look_pool = None  # the round is over: its queries are not the next round's
+        self._look_pool = []  # the round is over: its queries are not the next round's
         lik = self._likelihood(obs, self.hyps, self.judge)
         before = self.weights
         shown = self.shown_mass(record.scene)
