@@ -1446,14 +1446,19 @@ class Placed(Structure):
         score the mean of the two). The inner verdict is shared by every place and the place's
         share by every shape and order (memoised on the state: the hot path)."""
         order, _, place = p.partition("@")
-        k = ("placed-inner", self.key, order, g)
-        inner = f.memo.get(k)
-        if inner is None:
-            inner = f.memo[k] = (self.inner.holds(f, g, order), float(self.inner.score(f, g, order)))
+        inner = self.inner_judge(f, g, order)
         if not place:
             return inner
         share = self._share_memo(f, g, place)
         return inner[0] and share == 1.0, (inner[1] + share) / 2
+
+    def inner_judge(self, f: Facts, g: Group, order: str) -> tuple[bool, float]:
+        """(holds, score) of the inner shape in ``order`` (memoised on the state)."""
+        k = ("placed-inner", self.key, order, g)
+        inner = f.memo.get(k)
+        if inner is None:
+            inner = f.memo[k] = (self.inner.holds(f, g, order), float(self.inner.score(f, g, order)))
+        return inner
 
     @classmethod
     def _share_memo(cls, f: Facts, g: Group, place: str) -> float:

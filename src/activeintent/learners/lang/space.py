@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import NODES, QUANTS, Each, Form, Goal, all_clauses, parse_goal
+from activeintent.goals.language import NODES, QUANTS, Each, Form, Goal, Placed, all_clauses, parse_goal
 from activeintent.goals.planner import generic_moves, plan
 from activeintent.learners.bayes.hypotheses import random_scene
 from activeintent.world import WorldState, apply_skill, layout
@@ -79,6 +79,23 @@ class Compiled:
             shapes.setdefault((clauses[i].struct, clauses[i].stp), len(shapes))
         self.shapes = [(NODES["structure"][st], stp) for st, stp in shapes]
         self.f_shape = [shapes[(clauses[i].struct, clauses[i].stp)] for i in self.forms]
+        # A placed shape ("a row along the back edge") is its inner shape's verdict and, with a
+        # place, the group's share there: each judged once per group and state (Placed.judge).
+        inners: dict[tuple[str, str], int] = {}
+        places: dict[str, int] = {}
+        sh_inner, sh_place = [], []
+        for struct, stp in self.shapes:
+            if type(struct).judge is Placed.judge:
+                order, _, place = stp.partition("@")
+                sh_inner.append(inners.setdefault((struct.key, order), len(inners)))
+                sh_place.append(places.setdefault(place, len(places)) if place else -1)
+            else:
+                sh_inner.append(-1)
+                sh_place.append(-1)
+        self._inners = [(NODES["structure"][k], order) for k, order in inners]
+        self._places = list(places)
+        self._sh_inner = np.array(sh_inner, int)
+        self._sh_place = np.array(sh_place, int)
         self._f_index = np.array(self.forms, int)
         self._f_sel = np.array(self.f_sel, int)
         self._f_shape = np.array(self.f_shape, int)
@@ -175,17 +192,42 @@ class Compiled:
         return got
 
     def _judge_forms(self, f: Facts, holds: np.ndarray, score: np.ndarray) -> None:
-        """Every structure clause, each (shape, group) judged once (as Form.judge, without its
-        per-clause lookups); an empty group holds with score 1."""
+        """Every structure clause as Form.judge, without its per-clause lookups: each (shape,
+        group) judged once, a placed shape as its inner verdict per (inner shape, group) and its
+        share per (place, group), combined as Placed.judge does; an empty group holds with score 1."""
         groups, _, keys = self._form_keys(f)
+        n_groups = len(groups)
         uniq, inverse = np.unique(keys, return_inverse=True)
+        shape, gi = np.divmod(uniq, n_groups)
         h = np.ones(len(uniq), bool)
         sc = np.ones(len(uniq))
-        for u, k in enumerate(uniq.tolist()):
-            g = groups[k % len(groups)]
-            if g:
-                struct, stp = self.shapes[k // len(groups)]
-                h[u], sc[u] = struct.judge(f, g, stp)
+        filled = np.array([len(g) > 0 for g in groups], bool)[gi]
+        inner = self._sh_inner[shape]
+        for u in np.flatnonzero(filled & (inner < 0)).tolist():
+            struct, stp = self.shapes[shape[u]]
+            g = groups[gi[u]]
+            k = ("form", struct.key, stp, g)  # on the state: shared with the grown spaces' judges
+            got = f.memo.get(k)
+            if got is None:
+                got = f.memo[k] = struct.judge(f, g, stp)
+            h[u], sc[u] = got
+        rows = np.flatnonzero(filled & (inner >= 0))
+        if len(rows):
+            pairs, at_pair = np.unique(inner[rows] * n_groups + gi[rows], return_inverse=True)
+            ph = np.empty(len(pairs), bool)
+            ps = np.empty(len(pairs))
+            for j, k in enumerate(pairs.tolist()):
+                struct, order = self._inners[k // n_groups]
+                ph[j], ps[j] = struct.inner_judge(f, groups[k % n_groups], order)
+            h[rows] = ph[at_pair]
+            sc[rows] = ps[at_pair]
+            placed = rows[self._sh_place[shape[rows]] >= 0]
+            if len(placed):
+                pairs, at_pair = np.unique(self._sh_place[shape[placed]] * n_groups + gi[placed], return_inverse=True)
+                share = np.array([Placed._share_memo(f, groups[k % n_groups], self._places[k // n_groups])
+                                  for k in pairs.tolist()], float)[at_pair]
+                h[placed] &= share == 1.0
+                sc[placed] = (sc[placed] + share) / 2
         holds[self._f_index] = h[inverse]
         score[self._f_index] = sc[inverse]
 
