@@ -26,7 +26,16 @@ from pathlib import Path
 import numpy as np
 
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import NODES, QUANTS, Each, Form, Goal, Placed, all_clauses, parse_goal
+from activeintent.goals.language import (
+    NODES,
+    QUANTS,
+    Each,
+    Form,
+    Goal,
+    Placed,
+    all_clauses,
+    parse_goal,
+)
 from activeintent.goals.planner import generic_moves, plan
 from activeintent.learners.bayes.hypotheses import random_scene
 from activeintent.world import WorldState, apply_skill, layout
