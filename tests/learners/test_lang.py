@@ -96,6 +96,9 @@ def test_planner_satisfies_every_goal_it_claims_feasible():
 def test_compiled_judge_matches_the_goals():
     rng = np.random.default_rng(3)
     goals = [random_goal(rng) for _ in range(300)] + [Goal((Form("row", "rainbow", "all", ""),))]
+    # every structure with every parameter on the same group: verdicts shared by (shape, group)
+    # must not leak from one parameter to another
+    goals += [Goal((Form(key, p, "all", ""),)) for key, node in NODES["structure"].items() for p in node.params]
     comp = Compiled(goals)
     for _goal, _scene, state in feasible_pairs(rng, 6):
         f0 = facts(state)

@@ -115,7 +115,7 @@ def _relations(state: WorldState) -> Relations:
             if gap < NEXT_TO_GAP:
                 next_to.append(tuple(sorted((a, b))))  # type: ignore[arg-type]
     positions = {n: table_position_name(pos[n]) for n in names}
-    # built as is: every field is already of its type (validation took a third of this function)
+    # built as is: every field is already of its type (validation took a fifth of its time)
     return Relations.model_construct(on=on, inside=inside, next_to=next_to, on_table=on_table, table_position=positions)
 
 
