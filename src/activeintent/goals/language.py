@@ -1449,7 +1449,7 @@ class Placed(Structure):
         inner = self.inner_judge(f, g, order)
         if not place:
             return inner
-        share = self._share_memo(f, g, place)
+        share = self.share(f, g, place)
         return inner[0] and share == 1.0, (inner[1] + share) / 2
 
     def inner_judge(self, f: Facts, g: Group, order: str) -> tuple[bool, float]:
@@ -1461,7 +1461,8 @@ class Placed(Structure):
         return inner
 
     @classmethod
-    def _share_memo(cls, f: Facts, g: Group, place: str) -> float:
+    def share(cls, f: Facts, g: Group, place: str) -> float:
+        """Share of the group at the place (``_share``), memoised on the state."""
         k = ("placed-share", place, g)
         share = f.memo.get(k)
         if share is None:
@@ -1472,8 +1473,8 @@ class Placed(Structure):
         order, _, place = p.partition("@")
         if not self.inner.moved_ok(fb, fa, g, b, order):
             return False
-        return (not place or self._share_memo(fa, (b,), place) == 1.0
-                or self._share_memo(fa, g, place) >= self._share_memo(fb, g, place))
+        return (not place or self.share(fa, (b,), place) == 1.0
+                or self.share(fa, g, place) >= self.share(fb, g, place))
 
     def possible(self, g, objects, p):
         order, _, place = p.partition("@")
@@ -1728,12 +1729,7 @@ class Form:
 
     def judge(self, f: Facts) -> tuple[bool, float]:
         """(holds, score) in state ``f``, memoised per structure and group (clauses share them)."""
-        g = self.group_f(f)
-        k = ("form-judge", self.struct, self.stp, g)
-        got = f.memo.get(k)
-        if got is None:
-            got = f.memo[k] = (True, 1.0) if not g else self.structure.judge(f, g, self.stp)
-        return got
+        return structure_judge(f, self.struct, self.stp, self.group_f(f))
 
     def holds(self, f: Facts) -> bool:
         return self.judge(f)[0]
@@ -1756,6 +1752,17 @@ class Form:
 
 
 Clause = Each | Form
+
+
+def structure_judge(f: Facts, key: str, p: str, g: Group) -> tuple[bool, float]:
+    """(holds, score) of structure ``key`` with parameter ``p`` over group ``g`` in ``f`` (an
+    empty group holds with score 1), memoised on the state: every clause and compiled judge of
+    the same (shape, group) reads one verdict."""
+    k = ("form-judge", key, p, g)
+    got = f.memo.get(k)
+    if got is None:
+        got = f.memo[k] = (True, 1.0) if not g else NODES["structure"][key].judge(f, g, p)  # type: ignore[attr-defined]
+    return got
 
 
 @dataclass(frozen=True)

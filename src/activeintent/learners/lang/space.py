@@ -35,6 +35,7 @@ from activeintent.goals.language import (
     Placed,
     all_clauses,
     parse_goal,
+    structure_judge,
 )
 from activeintent.goals.planner import generic_moves, plan
 from activeintent.learners.bayes.hypotheses import random_scene
@@ -214,12 +215,7 @@ class Compiled:
         inner = self._sh_inner[shape]
         for u in np.flatnonzero(filled & (inner < 0)).tolist():
             struct, stp = self.shapes[shape[u]]
-            g = groups[gi[u]]
-            k = ("form", struct.key, stp, g)  # on the state: shared with the grown spaces' judges
-            got = f.memo.get(k)
-            if got is None:
-                got = f.memo[k] = struct.judge(f, g, stp)
-            h[u], sc[u] = got
+            h[u], sc[u] = structure_judge(f, struct.key, stp, groups[gi[u]])  # shared with the grown space's judge
         rows = np.flatnonzero(filled & (inner >= 0))
         if len(rows):
             pairs, at_pair = np.unique(inner[rows] * n_groups + gi[rows], return_inverse=True)
@@ -233,7 +229,7 @@ class Compiled:
             placed = rows[self._sh_place[shape[rows]] >= 0]
             if len(placed):
                 pairs, at_pair = np.unique(self._sh_place[shape[placed]] * n_groups + gi[placed], return_inverse=True)
-                share = np.array([Placed._share_memo(f, groups[k % n_groups], self._places[k // n_groups])
+                share = np.array([Placed.share(f, groups[k % n_groups], self._places[k // n_groups])
                                   for k in pairs.tolist()], float)[at_pair]
                 h[placed] &= share == 1.0
                 sc[placed] = (sc[placed] + share) / 2
