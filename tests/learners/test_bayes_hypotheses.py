@@ -147,3 +147,23 @@ def test_a_bowl_in_a_corner_cell_leaves_room_for_the_blocks(hyps, name, objects,
     state = WorldState(positions=layout(scene, seed))
     assert h.feasible(scene)
     assert plan_failure(h, state) is None
+
+
+def test_kept_plans_are_the_plans_of_that_state_and_variant_count(hyps):
+    """Hypothesis.plans keeps its answers: asked again (variants 1, then all, in either order;
+    the same objects in another order) it gives what a fresh planning gives."""
+    rng = np.random.default_rng(11)
+    checked = 0
+    for k in range(12):
+        scene = random_scene(rng)
+        state = WorldState(positions=layout(scene, 700 + k))
+        turned = WorldState(positions=dict(reversed(list(state.positions.items()))))
+        for h in hyps:
+            if not h.feasible(scene):
+                continue
+            n = max(c.leaf.variants for c in h.clauses)
+            for s in (state, turned, state):
+                assert h.plans(s, variants=1) == h._plans(s, 1)
+                assert h.plans(s) == h._plans(s, n)
+            checked += n > 1 and len(h._plans(state, n)) > 1
+    assert checked > 20  # hypotheses whose variants give more than one plan were among them

@@ -20,6 +20,7 @@ import hashlib
 import json
 import math
 import os
+from collections import OrderedDict
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
 from pathlib import Path
@@ -75,6 +76,10 @@ SUBJECTS = {
 # The grammar's regions of the table — its nine cells (world.skills.TABLE_POSITIONS) and its
 # halves — as the language says them: corners and halves are regions, the other cells cells.
 _REGION, _CELL = InRegion(), InCell()
+# Hypothesis.plans by (z, variants, positions); a hypothesis hashes by identity, so a key
+# keeps its z alive and never matches another one.
+_PLANS: OrderedDict[tuple, list[list[Skill]]] = OrderedDict()
+_PLANS_SIZE = 30000
 REGIONS = {
     "top left corner": (_REGION, "back left corner"), "top side": (_CELL, "top side"),
     "top right corner": (_REGION, "back right corner"), "left side": (_CELL, "left side"),
@@ -227,10 +232,22 @@ class Hypothesis(Intention):
         raise ValueError(f"no feasible scene of 3–5 objects found for {self.name!r}")
 
     def plans(self, state: WorldState, variants: int | None = None) -> list[list[Skill]]:
-        """Distinct plans that satisfy z from ``state`` (first = the canonical one)."""
+        """Distinct plans that satisfy z from ``state`` (first = the canonical one). A pure
+        function of (z, the exact positions in their order, variants): kept, since the final
+        answers ask it again for the same test scenes after every signal. Callers must not
+        change the lists."""
+        n = variants or max(c.leaf.variants for c in self.clauses)
+        key = (self, n, tuple(state.positions.items()))
+        out = _PLANS.get(key)
+        if out is None:
+            out = _PLANS[key] = self._plans(state, n)
+            if len(_PLANS) > _PLANS_SIZE:
+                _PLANS.popitem(last=False)
+        return out
+
+    def _plans(self, state: WorldState, n: int) -> list[list[Skill]]:
         out: list[list[Skill]] = []
         seen: set[str] = set()
-        n = variants or max(c.leaf.variants for c in self.clauses)
         for v in range(n):
             s, steps = state, []
             for c in self.clauses:
