@@ -7,7 +7,6 @@ import itertools
 import numpy as np
 
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.recipes import EveryBlock
 from activeintent.learners.bayes.hypotheses import Hypothesis
 from activeintent.world import WorldState
 from activeintent.world.trajectory import Trajectory
@@ -37,50 +36,10 @@ class _Clauses:
                     index[key] = len(self.clauses)
                     self.clauses.append(c)
                 self.idx[row, j] = index[key]
-        # One group per distinct (selector, excluded block); an "every block" leaf's per-block
-        # verdict depends on its relation and parameter only, so clauses that differ only in
-        # the selector share it (``_every``: that key, None for other leaves).
-        groups: dict[tuple, int] = {}
-        self.group_of = []
-        self.group_clause = []
-        self.every: list[tuple[int, str] | None] = []
-        for c in self.clauses:
-            gk = (c.selector, c.leaf.excluded())
-            if gk not in groups:
-                groups[gk] = len(self.group_clause)
-                self.group_clause.append(c)
-            self.group_of.append(groups[gk])
-            leaf = c.leaf
-            plain = type(leaf).judge is EveryBlock.judge and type(leaf).ok is EveryBlock.ok
-            self.every.append((id(leaf.rel), leaf.param) if plain else None)
-        self.steps = list(zip(self.clauses, self.group_of, self.every, strict=True))
-
-    def verdicts(self, f: Facts) -> list[tuple[bool, float, int]]:
-        """(holds, score, group size) per clause: what ``Clause.judge_f`` gives, with the groups
-        formed once per state and each block's "every" verdict shared across selectors."""
-        groups = [c.group_f(f) for c in self.group_clause]
-        shared: dict[tuple[int, str], dict[str, bool]] = {}
-        out = []
-        for c, gi, ek in self.steps:
-            g = groups[gi]
-            if ek is None:
-                out.append((*c.leaf.judge(f, g), len(g)))
-                continue
-            ok = shared.get(ek)
-            if ok is None:
-                ok = shared[ek] = {}
-            n = 0
-            for b in g:
-                v = ok.get(b)
-                if v is None:
-                    v = ok[b] = c.leaf.ok(f, b)
-                n += v
-            out.append((n == len(g), n / len(g) if g else 1.0, len(g)))
-        return out
 
     def judge(self, f: Facts) -> tuple[np.ndarray, np.ndarray]:
         """(satisfied, score) of the grammar hypotheses, in the order of ``grammar``."""
-        verdicts = self.verdicts(f) + [(True, 0.0, 0)]  # the pad last
+        verdicts = [c.judge_f(f) for c in self.clauses] + [(True, 0.0, 0)]  # the pad last
         holds = np.array([v[0] for v in verdicts], dtype=bool)
         score = np.array([v[1] for v in verdicts], dtype=float)
         size = np.array([v[2] for v in verdicts], dtype=int)
