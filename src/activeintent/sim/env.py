@@ -4,8 +4,8 @@
 >>> state = env.reset(["red block", "blue bowl", "green block"], seed=0)
 >>> traj = env.execute([PutIn(block="red block", bowl="blue bowl")])
 
-Each skill is one pick-and-place along IK waypoints (hover, descend, grasp, lift, move,
-lower, release, retreat). Where the block goes comes from the symbolic world model
+Each skill is one pick-and-place along straight grasp-point segments (hover, descend, grasp,
+lift, move, lower, release, retreat); the arm's joints are solved along them when drawn. Where the block goes comes from the symbolic world model
 (:func:`activeintent.world.predict.target_position`), so the simulated final state matches
 :func:`~activeintent.world.predict.apply_plan` up to settling. A skill that cannot be done is
 recorded as a failed step with its reason and a short pause; it never raises.
@@ -20,7 +20,7 @@ import pybullet as p
 from pydantic import BaseModel, Field, TypeAdapter, ValidationError, model_validator
 
 from activeintent.sim.assets import create_object, create_table
-from activeintent.sim.robot import FINGER_CLOSED, FINGER_OPEN, HOME_EE, SEED_POSES, Panda
+from activeintent.sim.robot import FINGER_CLOSED, FINGER_OPEN, HOME_EE, SEED_POSES, ArmReplay, Panda
 from activeintent.world.predict import SkillFailure, target_position
 from activeintent.world.scene import BLOCK_SIZE, BOWL_HEIGHT, Scene, SceneError, kind_of, layout
 from activeintent.world.skills import Skill
@@ -50,7 +50,6 @@ class SimConfig(BaseModel):
     place_tolerance: float = Field(0.02, gt=0, description="a block ending farther from its target fails")
     solver_iterations: int = Field(30, ge=5, description="constraint solver iterations per physics step")
     ik_tolerance: float = Field(0.005, gt=0, description="largest IK error at a pick or place pose")
-
     @model_validator(mode="after")
     def _rates(self) -> SimConfig:
         if self.physics_hz % self.log_hz:
@@ -67,8 +66,8 @@ class _Log:
 
     def __init__(self) -> None:
         self.poses: list[np.ndarray] = []
-        self.joints: list[np.ndarray] = []
-        self.ee: list[np.ndarray] = []
+        self.points: list[np.ndarray] = []  # commanded grasp point (the arm is solved from it when drawn)
+        self.fingers: list[float] = []
         self.closed: list[bool] = []
         self.step: list[int] = []
 
@@ -100,6 +99,8 @@ class PyBulletEnv:
         self._substeps = self.config.physics_hz // self.config.log_hz
         self._log: _Log | None = None
         self._current = -1  # index of the skill being executed (-1: idle)
+        self._hand = np.zeros(3)  # the commanded grasp point (what a held block follows)
+        self._finger = FINGER_OPEN  # the commanded finger opening
 
     # --- lifecycle ------------------------------------------------------------------------
     def __enter__(self) -> PyBulletEnv:
@@ -149,6 +150,8 @@ class PyBulletEnv:
         create_table(c)
         self._arm.reset()
         self.robot = self._arm
+        self._hand = self._arm.ee_pose()[0]  # the home pose's
+        self._finger = float(self._arm.home[-1])
         self.bodies = {name: create_object(c, name, positions[name]) for name in scene.objects}
         self.scene, self.seed = scene, seed
         for _ in range(round(self.config.initial_settle_s * self.config.physics_hz)):
@@ -178,60 +181,44 @@ class PyBulletEnv:
             np.concatenate(p.getBasePositionAndOrientation(b, physicsClientId=self.client))
             for b in self.bodies.values()
         ]))
-        log.joints.append(robot.joints())
-        pos, orn = robot.ee_pose()
-        log.ee.append(np.concatenate([pos, orn]))
+        log.points.append(self._hand.copy())
+        log.fingers.append(self._finger)
         log.closed.append(robot.grasped is not None)
         log.step.append(self._current)
 
     # --- motion primitives ----------------------------------------------------------------
-    def _advance(self, q_from: np.ndarray, q_to: np.ndarray) -> None:
-        """One log tick: joints interpolated over the physics substeps, objects simulated."""
+    def _advance(self, point: np.ndarray) -> None:
+        """One log tick: the commanded grasp point moves to ``point`` over the physics substeps
+        (a held block follows it) while the objects are simulated."""
         robot = self._require()
+        start, end = self._hand, np.asarray(point, dtype=float)
         held = robot.grasped is not None
-        if held:  # the held block's anchor moves with the hand, interpolated per substep
-            start = robot.ee_pose()[0]
-            robot.set_joints(q_to)
-            end = robot.ee_pose()[0]
-        robot.set_joints(q_to)
         for k in range(1, self._substeps + 1):
             if held:
                 robot.follow(start + (end - start) * (k / self._substeps))
             p.stepSimulation(physicsClientId=self.client)
+        self._hand = end
         self._record()
 
-    def _fingers(self) -> float:
-        return float(self._require().joints()[-1])
-
     def _move(self, target: np.ndarray, speed: float) -> None:
-        """Straight line of the grasp point to ``target`` (min-jerk timing, IK every log tick)."""
-        robot = self._require()
-        start = robot.ee_pose()[0]
+        """Straight line of the grasp point to ``target`` (min-jerk timing, one point per log
+        tick; the arm is solved along it by IK when drawn)."""
+        self._require()
+        start = self._hand
         dist = float(np.linalg.norm(target - start))
         duration = max(self.config.min_segment_s, dist / speed)
         n = max(1, round(duration * self.config.log_hz))
-        fingers = self._fingers()
-        q = robot.joints()
         for k in range(1, n + 1):
-            point = start + (target - start) * _min_jerk(k / n)
-            q_next, err = robot.solve(point, fingers=fingers)
-            if err > self.config.ik_tolerance:  # lost the configuration: restart from seeds
-                q_next, _ = robot.solve(point, seeds=list(SEED_POSES), fingers=fingers)
-            self._advance(q, q_next)
-            q = q_next
+            self._advance(start + (target - start) * _min_jerk(k / n))
 
     def _dwell(self, duration: float, fingers: float | None = None) -> None:
-        """Hold the arm still (optionally moving the fingers) while the physics runs."""
-        robot = self._require()
-        q = robot.joints()
+        """Hold the hand still (optionally moving the fingers) while the physics runs."""
         n = max(1, round(duration * self.config.log_hz))
-        f0 = q[-1]
+        f0 = self._finger
         for k in range(1, n + 1):
-            q_next = q.copy()
             if fingers is not None:
-                q_next[-2:] = f0 + (fingers - f0) * (k / n)
-            self._advance(q, q_next)
-            q = q_next
+                self._finger = f0 + (fingers - f0) * (k / n)
+            self._advance(self._hand)
 
     def _travel_height(self, exclude: str | None = None) -> float:
         tops = [
@@ -265,7 +252,7 @@ class PyBulletEnv:
             return log.last, reason
         self._move(np.array([*grasp_pt[:2], travel]), cfg.travel_speed)  # hover
         self._move(grasp_pt, cfg.vertical_speed)  # descend
-        robot.grasp(body)
+        robot.grasp(body, self._hand)
         self._dwell(cfg.grasp_s, FINGER_CLOSED)  # grasp
         offset = robot.grasp_offset_world()
         self._move(np.array([*grasp_pt[:2], travel]), cfg.vertical_speed)  # lift
@@ -310,11 +297,12 @@ class PyBulletEnv:
         if self.config.home_at_end and steps:
             self._move(np.array(HOME_EE), self.config.travel_speed)
         robot.release()  # nothing stays attached between plans
+        arm = ArmReplay(np.array(log.points), np.array(log.fingers), self.config.ik_tolerance)
         traj = Trajectory(
             scene=self.scene, seed=self.seed, dt=1.0 / self.config.log_hz,
             object_names=list(self.bodies),
-            object_poses=np.array(log.poses), joint_positions=np.array(log.joints),
-            ee_pose=np.array(log.ee), gripper_closed=np.array(log.closed, dtype=bool),
+            object_poses=np.array(log.poses), joint_positions=arm, ee_pose=arm,
+            gripper_closed=np.array(log.closed, dtype=bool),
             step_index=np.array(log.step, dtype=np.int64), steps=records,
             initial_state=initial, final_state=self.state(), renderer=_render,
         )

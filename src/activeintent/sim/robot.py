@@ -1,12 +1,15 @@
 """The Franka Panda from pybullet_data: inverse kinematics and a suction-style grasp.
 
-The arm is driven kinematically (joint positions are set every physics tick along IK
-waypoints), which is fast and exactly repeatable; its links do not collide with anything.
-The objects are fully simulated: a grasped block hangs on a fixed constraint that follows
-the hand, and is dropped into real contact with the table, bowls and other blocks.
+The arm is kinematic: its links touch nothing, and its joints are solved by IK along the
+commanded grasp points only when a trajectory is drawn (:class:`ArmReplay`). The objects are
+fully simulated: a grasped block hangs on a fixed constraint that follows the commanded grasp
+point, and is dropped into real contact with the table, bowls and other blocks.
 """
 
 from __future__ import annotations
+
+import threading
+from dataclasses import dataclass
 
 import numpy as np
 import pybullet as p
@@ -139,9 +142,10 @@ class Panda:
         return best, best_err
 
     # --- suction-style grasp ------------------------------------------------------------
-    def grasp(self, body: int) -> None:
-        """Hold ``body`` at its current offset from the grasp point; it keeps its orientation."""
-        pos, _ = self.ee_pose()
+    def grasp(self, body: int, at: np.ndarray | None = None) -> None:
+        """Hold ``body`` at its current offset from the grasp point ``at`` (default: where the
+        hand is); it keeps its orientation."""
+        pos = self.ee_pose()[0] if at is None else np.asarray(at, dtype=float)
         bpos, born = p.getBasePositionAndOrientation(body, physicsClientId=self.world)
         self._offset = np.array(bpos) - pos
         self._held_orn = born
@@ -178,3 +182,52 @@ class Panda:
         if self._grasp is not None:
             p.removeConstraint(self._grasp, physicsClientId=self.world)
         self._grasp = self._offset = self.grasped = None
+
+
+# --- the drawn arm ------------------------------------------------------------------------
+_REPLAY_ARM: Panda | None = None
+_REPLAY_LOCK = threading.Lock()
+
+
+def _replay_arm() -> Panda:
+    """This process's kinematic Panda for :class:`ArmReplay` (its own DIRECT client)."""
+    global _REPLAY_ARM
+    if _REPLAY_ARM is None:
+        _REPLAY_ARM = Panda(p.connect(p.DIRECT))
+    return _REPLAY_ARM
+
+
+@dataclass(frozen=True, eq=False)
+class ArmReplay:
+    """The arm's joints [T, 9] and hand pose [T, 7] along τ, solved by IK from the commanded
+    grasp points when first asked for (only drawing needs them: the physics moves a held block
+    along the commanded points, so an episode without video never solves IK per tick).
+
+    Tick 0 starts from the home pose; each later tick tracks from the one before (restarting
+    from SEED_POSES when tracking loses the point), as the hand moved."""
+
+    points: np.ndarray  # [T, 3] commanded grasp point per tick
+    fingers: np.ndarray  # [T] finger opening per tick
+    tolerance: float  # largest IK error before restarting from the seed poses
+
+    def __call__(self) -> tuple[np.ndarray, np.ndarray]:
+        with _REPLAY_LOCK:
+            arm = _replay_arm()
+            saved = arm.joints()
+            joints = np.zeros((len(self.points), arm.n_joints))
+            ee = np.zeros((len(self.points), 7))
+            q = np.array(arm.home, dtype=float)
+            for t, (point, fingers) in enumerate(zip(self.points, self.fingers, strict=True)):
+                if t > 0 and np.array_equal(point, self.points[t - 1]):  # the hand holds still
+                    q = q.copy()
+                    q[-2:] = fingers
+                else:
+                    arm.set_joints(q)
+                    q, err = arm.solve(point, fingers=fingers)
+                    if err > self.tolerance:
+                        q, _ = arm.solve(point, seeds=list(SEED_POSES), fingers=fingers)
+                arm.set_joints(q)
+                pos, orn = arm.ee_pose()
+                joints[t], ee[t] = q, np.concatenate([pos, orn])
+            arm.set_joints(saved)
+        return joints, ee

@@ -74,7 +74,9 @@ class Trajectory:
 
     Arrays have one row per tick: ``object_poses`` [T, N, 7] (xyz + quaternion xyzw, in the
     order of ``object_names``), ``joint_positions`` [T, J], ``ee_pose`` [T, 7],
-    ``gripper_closed`` [T], ``step_index`` [T] (-1 while idle).
+    ``gripper_closed`` [T], ``step_index`` [T] (-1 while idle). ``joint_positions`` and
+    ``ee_pose`` may be given as one callable returning both: it runs when either is first read
+    (an env's arm solved only for drawing).
     """
 
     scene: Scene
@@ -199,3 +201,23 @@ class Trajectory:
             final_state=WorldState.model_validate(header["final_state"]) if header["final_state"] else None,
             **arrays,
         )
+
+
+def _arm_array(name: str) -> property:
+    """``joint_positions`` / ``ee_pose``: an array, or computed (both at once) on first read."""
+
+    def get(self: Trajectory) -> np.ndarray:
+        value = self.__dict__[name]
+        if callable(value):
+            self.__dict__["joint_positions"], self.__dict__["ee_pose"] = value()
+            value = self.__dict__[name]
+        return value
+
+    def set(self: Trajectory, value: np.ndarray | Callable[[], tuple[np.ndarray, np.ndarray]]) -> None:
+        self.__dict__[name] = value
+
+    return property(get, set)
+
+
+Trajectory.joint_positions = _arm_array("joint_positions")  # type: ignore[assignment]
+Trajectory.ee_pose = _arm_array("ee_pose")  # type: ignore[assignment]
