@@ -122,7 +122,7 @@ def test_grammar_first_decoding_gives_llama_cpps_own_tokens(gguf_path):
     on = EmbeddedBackend(None, EmbeddedConfig(grammar_first=True))
     off = EmbeddedBackend(None, EmbeddedConfig(grammar_first=False))
     cases = [(ASK, Pick), (ASK, Odd), (learner_sized_messages(2), BenchGoal)]
-    steps = fallbacks = 0
+    steps = fallbacks = whole = 0
     for messages, schema in cases:
         request = ChatRequest(messages=messages, max_tokens=64, seed=0, json_schema=schema.model_json_schema(),
                               schema_name=schema.__name__)
@@ -132,7 +132,33 @@ def test_grammar_first_decoding_gives_llama_cpps_own_tokens(gguf_path):
         sampler = on.llama._sampler  # the generation's sampler stays set after the call
         assert isinstance(sampler, GrammarFirstGreedy)
         steps, fallbacks = steps + sampler.steps, fallbacks + sampler.fallbacks
-    assert 0 < fallbacks < steps
+        whole += sampler.whole
+    assert 0 < whole < fallbacks < steps  # the argmax, the shortlist and the whole vocabulary
+
+
+def test_the_shortlist_gives_the_whole_vocabularys_token_ties_included():
+    """When the grammar refuses the argmax, the most likely allowed token of the shortlist is
+    the most likely allowed token of the whole vocabulary (lowest id among equal logits), and
+    no token is chosen when the grammar allows none of the shortlist."""
+    from activeintent.llm.grammar_greedy import SHORTLIST, GrammarFirstGreedy
+
+    rng = np.random.default_rng(0)
+    checked = 0
+    for trial in range(200):
+        n = 5 * SHORTLIST
+        logits = rng.integers(0, 40 if trial % 2 else 4000, n).astype(np.float32)  # many ties
+        allowed = rng.random(n) < (0.002 if trial % 3 == 0 else 0.05)
+        sampler = GrammarFirstGreedy.__new__(GrammarFirstGreedy)
+        sampler._apply = lambda data, allowed=allowed: data["logit"].__setitem__(~allowed[data["id"]], -np.inf)
+        got = sampler._shortlisted(logits)
+        masked = np.where(allowed, logits, -np.inf)
+        if got is None:
+            edge = np.sort(logits)[-SHORTLIST]
+            assert not allowed[logits >= edge].any()
+        else:
+            checked += 1
+            assert got == int(np.argmax(masked))  # np.argmax: the lowest id among equals
+    assert 50 < checked < 200
 
 
 def test_a_kept_prefix_gives_the_logits_and_answers_of_a_fresh_evaluation(gguf_path):
@@ -174,3 +200,19 @@ def test_a_kept_prefix_gives_the_logits_and_answers_of_a_fresh_evaluation(gguf_p
     llama.prompt_tokens = None
     answers_on = [on.complete(r).text for r in requests]
     assert [off.complete(r).text for r in requests] == answers_on
+
+
+@pytest.mark.parametrize(("given", "spin"), [({}, "300"), ({"OMP_WAIT_POLICY": "PASSIVE"}, None),
+                                             ({"GOMP_SPINCOUNT": "5"}, "5")])
+def test_the_openmp_wait_is_a_short_spin_unless_the_user_chose(given, spin):
+    """ggml waits at an OpenMP barrier after every operation: a short spin by default (see
+    embedded.py for the measurements), whatever the user set otherwise."""
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")} | given
+    out = subprocess.run([sys.executable, "-c", "import os, activeintent.llm.embedded; "
+                          "print(os.environ.get('GOMP_SPINCOUNT'))"], env=env, capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.strip() == str(spin)

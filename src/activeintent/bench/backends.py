@@ -23,7 +23,7 @@ BACKENDS = ("local", "ray")
 # Variables a worker of an existing cluster would not otherwise see (its processes were started
 # by `ray start`, not from this shell): the model endpoint and the project's own settings.
 FORWARDED_PREFIXES = ("ACTIVEINTENT_",)
-FORWARDED_NAMES = ("OPENAI_API_KEY", "OPENAI_BASE_URL", "OMP_WAIT_POLICY")
+FORWARDED_NAMES = ("OPENAI_API_KEY", "OPENAI_BASE_URL", "OMP_WAIT_POLICY", "GOMP_SPINCOUNT")
 
 # Tasks kept in flight per CPU of the cluster: enough to keep every worker busy, few enough that
 # a killed driver loses little and a bench of 100 000 episodes is not one huge submission.

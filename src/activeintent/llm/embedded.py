@@ -20,10 +20,14 @@ from pydantic import BaseModel, Field
 from activeintent.llm.backend import Backend, ChatRequest, Completion
 from activeintent.llm.base import Message, ModelError, ModelUnavailableError, StructuredOutputError
 
-# llama.cpp's OpenMP workers spin while waiting by default; on a busy 2-core machine (physics,
-# other processes) that makes generation several times slower. Must be set before the library
-# loads; a value the user set wins.
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+# ggml waits at an OpenMP barrier after every operation. libgomp's default spin (300,000 turns)
+# holds a core another process may need (a learner-sized call took 4.4 s with one core busy);
+# not spinning at all (OMP_WAIT_POLICY=PASSIVE) sleeps and wakes at every barrier (2.0 s alone).
+# A short spin keeps most of both: 1.57 s alone, 3.06 s with one core busy (2.87 s passive).
+# Same answers: waiting does not change the arithmetic. Must be set before libgomp loads; a
+# policy or spin count the user set wins.
+if "OMP_WAIT_POLICY" not in os.environ:
+    os.environ.setdefault("GOMP_SPINCOUNT", "300")
 
 
 def default_model_dir() -> Path:
