@@ -167,3 +167,26 @@ def test_kept_plans_are_the_plans_of_that_state_and_variant_count(hyps):
                 assert h.plans(s) == h._plans(s, n)
             checked += n > 1 and len(h._plans(state, n)) > 1
     assert checked > 20  # hypotheses whose variants give more than one plan were among them
+
+
+def test_kept_predictions_are_those_of_that_state_and_plan(hyps):
+    """candidates.predict keeps its τ: asked again for a plan (the same objects in another
+    order, a prefix of the plan) it gives what the symbolic world model gives now."""
+    from activeintent.envs.symbolic import symbolic_trajectory
+    from activeintent.learners.bayes.candidates import predict
+
+    rng = np.random.default_rng(12)
+    checked = 0
+    for k in range(10):
+        scene = random_scene(rng)
+        state = WorldState(positions=layout(scene, 900 + k))
+        turned = WorldState(positions=dict(reversed(list(state.positions.items()))))
+        for h in hyps[:40]:
+            for plan in h.plans(state)[:2]:
+                for s, p in ((state, plan), (turned, plan), (state, plan[:1]), (state, plan)):
+                    got, fresh = predict(s, p), symbolic_trajectory(s.scene, s, p)
+                    assert got.plan == list(p) and got.traj.object_names == fresh.object_names
+                    assert got.traj.outcome == fresh.outcome
+                    assert np.array_equal(got.traj.object_poses, fresh.object_poses)
+                    checked += len(p) > 1
+    assert checked > 50

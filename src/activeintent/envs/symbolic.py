@@ -21,33 +21,50 @@ DT = 0.05
 
 
 def symbolic_trajectory(scene: Scene, state: WorldState, plan: Sequence[Skill], seed: int = 0) -> Trajectory:
-    """τ for ``plan`` from ``state`` on the symbolic world model."""
+    """τ for ``plan`` from ``state`` on the symbolic world model (its pose arrays are made
+    when first read: a learner predicting outcomes needs only the steps)."""
     plan = list(plan)
     states, fails = apply_plan(state, plan)
     names = list(state.positions)
     per = int(round(STEP_SECONDS / DT))
     n_ticks = per * len(plan) + 1
-    poses = np.zeros((n_ticks, len(names), 7))
-    poses[..., 6] = 1.0
-    poses[:, :, :3] = np.array([state.positions[n] for n in names])
     step_index = np.full(n_ticks, -1)
     records, current = [], state
     for k, (step, after, fail) in enumerate(zip(plan, states, fails, strict=True)):
         start, end = k * per, (k + 1) * per
         step_index[start:end] = k
-        poses[end:, :, :3] = np.array([after.positions[n] for n in names])
         records.append(StepRecord(
             index=k, skill=step, start_tick=start, reveal_tick=start + int(round(REVEAL_FRACTION * per)),
             end_tick=end, ok=fail is None, reason=None if fail is None else fail.reason,
             state_before=current, state_after=after,
         ))
         current = after
+    poses = _Poses(names, [state, *states], per)
     return Trajectory(
         scene=scene, seed=seed, dt=DT, object_names=names, object_poses=poses,
-        joint_positions=np.zeros((n_ticks, 7)), ee_pose=np.zeros((n_ticks, 7)),
+        joint_positions=poses.arm, ee_pose=poses.arm,
         gripper_closed=np.zeros(n_ticks, dtype=bool), step_index=step_index, steps=records,
         initial_state=state, final_state=current,
     )
+
+
+class _Poses:
+    """The pose arrays of a symbolic τ: each block jumps to its next position at a step's end."""
+
+    def __init__(self, names: list[str], states: list[WorldState], per: int):
+        self.names, self.states, self.per = names, states, per
+
+    def __call__(self) -> np.ndarray:
+        n_ticks = self.per * (len(self.states) - 1) + 1
+        poses = np.zeros((n_ticks, len(self.names), 7))
+        poses[..., 6] = 1.0
+        for k, st in enumerate(self.states):
+            poses[k * self.per:, :, :3] = np.array([st.positions[n] for n in self.names])
+        return poses
+
+    def arm(self) -> dict[str, np.ndarray]:
+        n_ticks = self.per * (len(self.states) - 1) + 1
+        return {"joint_positions": np.zeros((n_ticks, 7)), "ee_pose": np.zeros((n_ticks, 7))}
 
 
 class SymbolicEnv:

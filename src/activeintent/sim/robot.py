@@ -210,7 +210,7 @@ class ArmReplay:
     fingers: np.ndarray  # [T] finger opening per tick
     tolerance: float  # largest IK error before restarting from the seed poses
 
-    def __call__(self) -> tuple[np.ndarray, np.ndarray]:
+    def __call__(self) -> dict[str, np.ndarray]:
         with _REPLAY_LOCK:
             arm = _replay_arm()
             saved = arm.joints()
@@ -230,4 +230,4 @@ class ArmReplay:
                 pos, orn = arm.ee_pose()
                 joints[t], ee[t] = q, np.concatenate([pos, orn])
             arm.set_joints(saved)
-        return joints, ee
+        return {"joint_positions": joints, "ee_pose": ee}

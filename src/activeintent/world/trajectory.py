@@ -74,9 +74,9 @@ class Trajectory:
 
     Arrays have one row per tick: ``object_poses`` [T, N, 7] (xyz + quaternion xyzw, in the
     order of ``object_names``), ``joint_positions`` [T, J], ``ee_pose`` [T, 7],
-    ``gripper_closed`` [T], ``step_index`` [T] (-1 while idle). ``joint_positions`` and
-    ``ee_pose`` may be given as one callable returning both: it runs when either is first read
-    (an env's arm solved only for drawing).
+    ``gripper_closed`` [T], ``step_index`` [T] (-1 while idle). ``object_poses``,
+    ``joint_positions`` and ``ee_pose`` may be given as callables run when first read (an env's
+    arm solved only for drawing, a predicted τ whose poses nobody looks at).
     """
 
     scene: Scene
@@ -97,7 +97,7 @@ class Trajectory:
 
     @property
     def n_ticks(self) -> int:
-        return int(self.object_poses.shape[0])
+        return int(self.step_index.shape[0])
 
     @property
     def duration(self) -> float:
@@ -203,21 +203,27 @@ class Trajectory:
         )
 
 
-def _arm_array(name: str) -> property:
-    """``joint_positions`` / ``ee_pose``: an array, or computed (both at once) on first read."""
+
+def _deferred(name: str) -> property:
+    """An array field of τ that may be given as a callable, run on first read: it returns the
+    array, or a dict of arrays for this and other deferred fields (computed together)."""
 
     def get(self: Trajectory) -> np.ndarray:
         value = self.__dict__[name]
         if callable(value):
-            self.__dict__["joint_positions"], self.__dict__["ee_pose"] = value()
+            made = value()
+            if isinstance(made, dict):
+                self.__dict__.update(made)
+            else:
+                self.__dict__[name] = made
             value = self.__dict__[name]
         return value
 
-    def set(self: Trajectory, value: np.ndarray | Callable[[], tuple[np.ndarray, np.ndarray]]) -> None:
+    def set(self: Trajectory, value: np.ndarray | Callable[[], np.ndarray | dict[str, np.ndarray]]) -> None:
         self.__dict__[name] = value
 
     return property(get, set)
 
 
-Trajectory.joint_positions = _arm_array("joint_positions")  # type: ignore[assignment]
-Trajectory.ee_pose = _arm_array("ee_pose")  # type: ignore[assignment]
+for _name in ("object_poses", "joint_positions", "ee_pose"):
+    setattr(Trajectory, _name, _deferred(_name))
