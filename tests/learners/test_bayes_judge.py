@@ -63,3 +63,20 @@ def test_vectorised_judge_equals_each_hypothesis():
                 moved = next((b for b in before.blocks if before.positions[b] != after.positions[b]), before.blocks[0])
                 steps.append((fb, fa, moved, bool(rng.random() < 0.8)))
             assert np.array_equal(first_away(hyps, steps, token), _reference_first_away(hyps, steps))
+
+
+def test_vectorised_feasibility_equals_each_hypothesis():
+    """HypothesisJudge.feasible (clause by clause, once per distinct clause) says what every
+    hypothesis's own feasible(scene) says, scene for scene."""
+    from activeintent.learners.bayes.judge import HypothesisJudge
+
+    rng = np.random.default_rng(5)
+    for hyps in (tuple(enumerate_hypotheses()), hypothesis_space()):
+        judge_ = HypothesisJudge(hyps)
+        kinds = set()
+        for _ in range(60):
+            scene = random_scene(rng)
+            want = np.array([h.feasible(scene) for h in hyps])
+            assert np.array_equal(judge_.feasible(scene.objects), want)
+            kinds.add((bool(want.all()), bool(want.any())))
+        assert (False, True) in kinds  # scenes that show some hypotheses and not others

@@ -50,6 +50,13 @@ class _Clauses:
         n = size[self.idx].sum(axis=1)
         return sat, np.where(n > 0, total / np.maximum(n, 1), 1.0)
 
+    def feasible(self, objects: tuple[str, ...], blocks: list[str]) -> np.ndarray:
+        """Per grammar hypothesis: can a scene of ``objects`` show it? (every clause has a
+        group there that its behaviour can be shown on, as :meth:`Hypothesis.feasible`)"""
+        ok = np.array([bool(g) and c.leaf.feasible(objects, g) for c in self.clauses
+                       for g in (c.group(blocks),)] + [True], dtype=bool)
+        return ok[self.idx].all(axis=1)
+
     def moved_off(self, fb: Facts, fa: Facts, block: str, rows: np.ndarray) -> np.ndarray:
         """Per grammar hypothesis in ``rows``: did moving ``block`` leave a place z allows?"""
         off = np.zeros(len(self.clauses) + 1, dtype=bool)
@@ -65,7 +72,7 @@ class _Clauses:
 def _judged_by_clauses(h: Hypothesis) -> bool:
     t = type(h)
     return (t.holds_f is Hypothesis.holds_f and t.score_f is Hypothesis.score_f
-            and t.moved_off is Hypothesis.moved_off and bool(h.clauses))
+            and t.moved_off is Hypothesis.moved_off and t.feasible is Hypothesis.feasible and bool(h.clauses))
 
 
 _COMPILED: dict[object, _Clauses] = {}
@@ -146,6 +153,8 @@ class HypothesisJudge:
         self.token = next(_TOKENS)
         self._away: dict[int, tuple[Trajectory, np.ndarray]] = {}
         self._feasible: dict[tuple[str, ...], np.ndarray] = {}
+        # hypotheses that judge in batches (model-proposed code); the others' prefetch does nothing
+        self._batched = [h for h in hyps if type(h).prefetch is not Hypothesis.prefetch]
 
     def feasible(self, objects: tuple[str, ...] | list[str]) -> np.ndarray:
         """Per hypothesis: can a scene of ``objects`` show it? (memoised per scene)"""
@@ -155,7 +164,11 @@ class HypothesisJudge:
             from activeintent.world import Scene
 
             scene = Scene(objects=list(key))
-            got = np.fromiter((h.feasible(scene) for h in self.hyps), bool, self.size)
+            comp = _compiled(self.hyps, self.token)
+            got = np.zeros(self.size, dtype=bool)
+            got[comp.grammar] = comp.feasible(tuple(scene.objects), scene.blocks)
+            for i in comp.own:
+                got[i] = self.hyps[i].feasible(scene)
             if len(self._feasible) > 4096:
                 self._feasible.clear()
             self._feasible[key] = got
@@ -163,13 +176,13 @@ class HypothesisJudge:
 
     def prefetch(self, states: list[Facts]) -> None:
         """Judge many states at once (hypotheses that run code in a sandbox batch them)."""
-        for h in self.hyps:
+        for h in self._batched:
             h.prefetch(states)
 
     def judge(self, f: Facts) -> tuple[np.ndarray, np.ndarray]:
         """(satisfied, score) of the state behind ``f`` under every hypothesis."""
         if ("judge", self.token) not in f.memo:  # query selection asks again and again
-            for h in self.hyps:
+            for h in self._batched:
                 h.prefetch([f])
         return judge(self.hyps, f, self.token)
 
@@ -179,7 +192,7 @@ class HypothesisJudge:
 
     def step_away(self, fb: Facts, fa: Facts, block: str, ok: bool = True) -> np.ndarray:
         """Per z: does moving ``block`` (facts before → after) move away from z?"""
-        for h in self.hyps:
+        for h in self._batched:
             h.prefetch([fb, fa])
         return first_away(self.hyps, [(fb, fa, block, ok)], self.token) == 0
 
@@ -188,7 +201,7 @@ class HypothesisJudge:
         if hit is not None and hit[0] is traj:
             return hit[1]
         steps = trajectory_steps(traj)
-        for h in self.hyps:
+        for h in self._batched:
             h.prefetch([f for st in steps for f in st[:2]])
         away = first_away(self.hyps, steps, self.token)
         if len(self._away) > 4096:
