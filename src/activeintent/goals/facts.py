@@ -73,8 +73,12 @@ def _key(state: WorldState) -> tuple:
 
 
 def state_key(f: Facts) -> tuple:
-    """Identity of the state behind ``f`` (positions to 1 mm)."""
-    return tuple((n, round(p[0], 3), round(p[1], 3), round(p[2], 3)) for n, p in f.pos.items())
+    """Identity of the state behind ``f`` (positions to 1 mm; kept on ``f``)."""
+    got = f.memo.get("state_key")
+    if got is None:
+        got = f.memo["state_key"] = tuple((n, round(p[0], 3), round(p[1], 3), round(p[2], 3))
+                                          for n, p in f.pos.items())
+    return got
 
 
 _CACHE: OrderedDict[tuple, Facts] = OrderedDict()
