@@ -149,15 +149,20 @@ def test_a_bowl_in_a_corner_cell_leaves_room_for_the_blocks(hyps, name, objects,
     assert plan_failure(h, state) is None
 
 
+def _states_and_turned(seed: int, n: int, first_layout: int):
+    """``n`` random scenes laid out: (scene, state, the same positions in reverse order)."""
+    rng = np.random.default_rng(seed)
+    for k in range(n):
+        scene = random_scene(rng)
+        state = WorldState(positions=layout(scene, first_layout + k))
+        yield scene, state, WorldState(positions=dict(reversed(list(state.positions.items()))))
+
+
 def test_kept_plans_are_the_plans_of_that_state_and_variant_count(hyps):
     """Hypothesis.plans keeps its answers: asked again (variants 1, then all, in either order;
     the same objects in another order) it gives what a fresh planning gives."""
-    rng = np.random.default_rng(11)
     checked = 0
-    for k in range(12):
-        scene = random_scene(rng)
-        state = WorldState(positions=layout(scene, 700 + k))
-        turned = WorldState(positions=dict(reversed(list(state.positions.items()))))
+    for scene, state, turned in _states_and_turned(11, 12, 700):
         for h in hyps:
             if not h.feasible(scene):
                 continue
@@ -175,12 +180,8 @@ def test_kept_predictions_are_those_of_that_state_and_plan(hyps):
     from activeintent.envs.symbolic import symbolic_trajectory
     from activeintent.learners.bayes.candidates import predict
 
-    rng = np.random.default_rng(12)
     checked = 0
-    for k in range(10):
-        scene = random_scene(rng)
-        state = WorldState(positions=layout(scene, 900 + k))
-        turned = WorldState(positions=dict(reversed(list(state.positions.items()))))
+    for _, state, turned in _states_and_turned(12, 10, 900):
         for h in hyps[:40]:
             for plan in h.plans(state)[:2]:
                 for s, p in ((state, plan), (turned, plan), (state, plan[:1]), (state, plan)):

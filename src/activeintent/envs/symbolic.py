@@ -53,18 +53,17 @@ class _Poses:
 
     def __init__(self, names: list[str], states: list[WorldState], per: int):
         self.names, self.states, self.per = names, states, per
+        self.n_ticks = per * (len(states) - 1) + 1
 
     def __call__(self) -> np.ndarray:
-        n_ticks = self.per * (len(self.states) - 1) + 1
-        poses = np.zeros((n_ticks, len(self.names), 7))
+        poses = np.zeros((self.n_ticks, len(self.names), 7))
         poses[..., 6] = 1.0
         for k, st in enumerate(self.states):
             poses[k * self.per:, :, :3] = np.array([st.positions[n] for n in self.names])
         return poses
 
     def arm(self) -> dict[str, np.ndarray]:
-        n_ticks = self.per * (len(self.states) - 1) + 1
-        return {"joint_positions": np.zeros((n_ticks, 7)), "ee_pose": np.zeros((n_ticks, 7))}
+        return {"joint_positions": np.zeros((self.n_ticks, 7)), "ee_pose": np.zeros((self.n_ticks, 7))}
 
 
 class SymbolicEnv:

@@ -5,7 +5,8 @@
 >>> traj = env.execute([PutIn(block="red block", bowl="blue bowl")])
 
 Each skill is one pick-and-place along straight grasp-point segments (hover, descend, grasp,
-lift, move, lower, release, retreat); the arm's joints are solved along them when drawn. Where the block goes comes from the symbolic world model
+lift, move, lower, release, retreat); the arm's joints are solved along them when drawn. Where
+the block goes comes from the symbolic world model
 (:func:`activeintent.world.predict.target_position`), so the simulated final state matches
 :func:`~activeintent.world.predict.apply_plan` up to settling. A skill that cannot be done is
 recorded as a failed step with its reason and a short pause; it never raises.
@@ -50,6 +51,7 @@ class SimConfig(BaseModel):
     place_tolerance: float = Field(0.02, gt=0, description="a block ending farther from its target fails")
     solver_iterations: int = Field(30, ge=5, description="constraint solver iterations per physics step")
     ik_tolerance: float = Field(0.005, gt=0, description="largest IK error at a pick or place pose")
+
     @model_validator(mode="after")
     def _rates(self) -> SimConfig:
         if self.physics_hz % self.log_hz:

@@ -203,7 +203,6 @@ class Trajectory:
         )
 
 
-
 def _deferred(name: str) -> property:
     """An array field of τ that may be given as a callable, run on first read: it returns the
     array, or a dict of arrays for this and other deferred fields (computed together)."""

@@ -17,6 +17,7 @@ from activeintent.envs.symbolic import symbolic_trajectory
 from activeintent.goals.facts import facts, state_key
 from activeintent.learners.bayes.hypotheses import Hypothesis
 from activeintent.world import Skill, WorldState, apply_skill
+from activeintent.world.skills import skill_key
 from activeintent.world.trajectory import Trajectory
 
 
@@ -41,7 +42,7 @@ _PREDICTED_CAP = 8192
 def predict(state: WorldState, plan: list[Skill]) -> Outcome:
     """``plan`` from ``state`` on the symbolic world model (kept by the exact positions, in
     order, and the skills: the same predicted τ, shared)."""
-    key = (tuple(state.positions.items()), tuple((type(s).__name__, *s.__dict__.values()) for s in plan))
+    key = (tuple(state.positions.items()), tuple(skill_key(s) for s in plan))
     got = _PREDICTED.get(key)
     if got is None:
         got = _PREDICTED[key] = Outcome(list(plan), symbolic_trajectory(state.scene, state, plan))
