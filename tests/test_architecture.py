@@ -291,3 +291,36 @@ def test_held_out_suites_stay_independent_of_the_goal_language(suite):
             "activeintent.world"} <= set(closure)  # the walk reaches the helpers they share
     via = {m: closure[m] for m in closure if m.startswith("activeintent.goals")}
     assert not via, f"{suite} reaches the goal language through (module: imported by): {via}"
+
+
+def test_every_path_the_architecture_doc_names_exists():
+    """docs/architecture.md's layout and file names match the tree: each file or folder it names
+    (in the layout block, or as `path.py` in its text) exists under src/activeintent or the root."""
+    import re
+
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "docs" / "architecture.md").read_text()
+    layout = text.split("```\nsrc/activeintent/", 1)[1].split("```", 1)[0]
+    named: set[str] = set()
+    for line in ("src/activeintent/\n" + layout).splitlines():
+        m = re.match(r"^(\s*)([\w.-]+/|[\w.-]+\.py)\s", line + " ")
+        if not m:
+            continue
+        indent, name = len(m.group(1)), m.group(2)
+        if indent == 0:
+            if name != "src/activeintent/":
+                named.add(name)
+            continue
+        if indent == 2:
+            top = name
+            named.add(top)
+        elif indent == 4 and name.endswith("/"):
+            named.add(f"{top}{name}")
+    named |= set(re.findall(r"`((?:[\w-]+/)*[\w-]+\.(?:py|md|json|html|txt))`", text))
+    named |= set(re.findall(r"\b[\w]+\.py\b", layout))  # every module the layout lists
+    named -= {"summary.json", "rounds.jsonl", "results.jsonl", "bench.json"}  # files a run writes
+    where = [root / "src" / "activeintent", root, root / "src" / "activeintent" / "learners", root / "examples"]
+    src_files = [str(p) for p in (root / "src" / "activeintent").rglob("*")]
+    missing = [n for n in sorted(named) if not any((w / n).exists() for w in where)
+               and not any(f.endswith("/" + n) for f in src_files)]
+    assert named and not missing, missing

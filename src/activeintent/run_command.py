@@ -116,6 +116,7 @@ def run(
     user: opt.User = D.user,
     new_scene: opt.NewScene = D.new_scene,
     prior: opt.Prior = D.prior,
+    scenes: opt.Scenes = D.scenes,
     llm: opt.Llm = D.llm,
     vlm: opt.Vlm = None,
     base_url: opt.BaseUrl = None,
@@ -150,7 +151,7 @@ def run(
     try:
         spec = opt.run_spec(
             method=method, intention=intention, intention_file=intention_file, plugins=plugin, budget=budget,
-            seed=seed, test_seed=test_seed, test_scenes=test_scenes, test_pool=test_pool, env=env, user=user, new_scene=new_scene, prior=prior, llm=llm,
+            seed=seed, test_seed=test_seed, test_scenes=test_scenes, test_pool=test_pool, env=env, user=user, new_scene=new_scene, prior=prior, scenes=scenes, llm=llm,
             vlm=vlm, base_url=base_url, cache=cache, cache_mode=cache_mode, executor=executor,
             retriever=retriever, epsilon=epsilon, early_threshold=early_threshold, variant=variant, video=video,
             design_scenes=design_scenes,

@@ -98,6 +98,8 @@ class LearnerConfig(BaseModel):
 
     method: str = DEFAULT_METHOD
     prior: str = Field("length", pattern="^(length|uniform)$")
+    scenes: str = Field("sampled", pattern="^(sampled|belief)$",
+                        description="bayes-* and lang-*: sampled scenes, or scenes the belief expects to show z")
     epsilon: float = Field(2.0, ge=0, description="ε: seconds before the stop for image I_b")
     early_threshold: float | None = Field(2.0, ge=0, description="eq. 3: a stop earlier than this shows no I_b (None: ε)")
     variant: str = Field("faithful", description="the paper's methods: faithful (as the paper ran them) | structured")
@@ -197,6 +199,7 @@ OPTIONS: dict[str, tuple[str | None, str]] = {
     "user": ("user", "preset"),
     "new_scene": ("protocol", "new_scene"),
     "prior": ("learner", "prior"),
+    "scenes": ("learner", "scenes"),
     "llm": ("models", "llm"),
     "vlm": ("models", "vlm"),
     "base_url": ("models", "base_url"),

@@ -167,7 +167,7 @@ def test_grammar_only_example_intentions_load_and_are_not_named_ones():
 
     from activeintent.intentions.registry import INTENTION_NAMES, load_intention_file
 
-    path = Path(__file__).resolve().parents[2] / "examples" / "grammar_intentions.py"
+    path = Path(__file__).resolve().parents[2] / "experiments" / "grammar-intentions" / "grammar_intentions.py"
     for name in ("PINK_BOWL", "NEXT_TO_YELLOW", "LEFT_SIDE", "WARM_LEFT_COOL_RIGHT"):
         intention = load_intention_file(f"{path}:{name}")
         assert intention.name not in INTENTION_NAMES and intention.description

@@ -18,7 +18,7 @@ from activeintent.learners.lang.space import Compiled
 from activeintent.signals import get_signal
 from activeintent.spec import ProtocolConfig
 from activeintent.users.simulated import SimulatedUser, user_profile
-from activeintent.world import WorldState, apply_plan, apply_skill, layout
+from activeintent.world import WorldState, apply_skill, layout
 
 CLAUSES = all_clauses()
 
@@ -252,27 +252,6 @@ def test_every_sampled_goal_of_the_space_gets_a_plan_wherever_it_is_called_feasi
                     failures.append((goal.key, objects, "feasible intention without a plan"))
     assert not failures, failures
     assert planned >= 100
-
-
-def test_the_final_answer_can_satisfy_two_likely_goals_with_one_plan():
-    """A belief split between two compatible goals, neither of whose own plans satisfies the
-    other: with final_joint the final answer runs a plan for both (expected success 1, not 0.5)."""
-    from activeintent.learners.lang.learner import LangConfig
-    from activeintent.world import Scene
-
-    red, blue = parse_goal("every colour:red in-the-bowl:red"), parse_goal("every colour:blue in-the-bowl:blue")
-    scene = Scene(objects=["red block", "blue block", "red bowl", "blue bowl"])
-    state = WorldState(positions=layout(scene, 0))
-    assert not red.holds(facts(state)) and not blue.holds(facts(state))
-    got = {}
-    for joint in (0, 2):
-        learner = LangLearner("stop", rng=0, config=LangConfig(prior="uniform", final_joint=joint),
-                              hypotheses=LangSpace([red, blue]).hypotheses)
-        est = learner.final(scene, state)
-        end = apply_plan(state, est.plans[0])[0][-1]
-        got[joint] = (est.why["expected_success"], red.holds(facts(end)) + blue.holds(facts(end)))
-    assert got[0] == (0.5, 1)
-    assert got[2] == (1.0, 2)
 
 
 def test_the_space_checks_what_a_scene_allows_as_each_clause_does_alone():

@@ -106,10 +106,10 @@ def test_the_feature_map_names_no_intention():
 
 
 def test_the_methods_are_registered():
-    assert {"reward-preference", "reward-stop", "reward-preference-noplanner", "reward-stop-noplanner"} <= set(method_names())
+    assert {"reward-preference", "reward-stop"} <= set(method_names())
 
 
-@pytest.mark.parametrize("method", ["reward-stop", "reward-preference-noplanner"])
+@pytest.mark.parametrize("method", ["reward-stop", "reward-preference"])
 def test_same_seed_same_episode(tmp_path, method):
     def once(out, seed=9):
         build_episode(RunSpec.from_options(method=method, intention="color-mismatch", env="symbolic", llm="none",

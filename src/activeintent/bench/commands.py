@@ -55,6 +55,7 @@ def bench(
     user: opt.User = D.user,
     new_scene: opt.NewScene = D.new_scene,
     prior: opt.Prior = D.prior,
+    scenes: opt.Scenes = D.scenes,
     llm: opt.Llm = D.llm,
     vlm: opt.Vlm = None,
     base_url: opt.BaseUrl = None,
@@ -94,7 +95,7 @@ def bench(
             trials = trials or preset_trials
         trials = trials or 20
         run = opt.run_spec(plugins=plugin, budget=budget, test_scenes=test_scenes, test_pool=test_pool, env=env, user=user,
-                           new_scene=new_scene, prior=prior, llm=llm, vlm=vlm, base_url=base_url, cache=cache,
+                           new_scene=new_scene, prior=prior, scenes=scenes, llm=llm, vlm=vlm, base_url=base_url, cache=cache,
                            cache_mode=cache_mode, executor=executor, retriever=retriever, variant=variant,
                            epsilon=epsilon, early_threshold=early_threshold, curve=curve, video="none")
         method_list = _split(methods) or ["bayes-preference", "bayes-stop", "zero-signal", "random-query"]

@@ -98,7 +98,7 @@ def wilson(successes: float, n: int, z: float = 1.96) -> tuple[float, float]:
 
 
 # EIG learners and the baselines that share their belief but ask at random; the decision-aware
-# learners and the hybrids (examples/hybrid.py) against the language learners they extend.
+# learners and the hybrids (experiments/hybrid/hybrid.py) against the language learners they extend.
 PAIRED = (("bayes-stop", "random-query"), ("bayes-preference", "random-query-preference"),
           ("decide-stop", "lang-stop"), ("decide-preference", "lang-preference"),
           ("hybrid-stop", "lang-stop"), ("hybrid-preference", "lang-preference"),

@@ -27,6 +27,20 @@ ADDED_IN_FORMAT_3 = frozenset({"diagnostics", "final_scene"})
 # that marks the new meaning: final_z / final_goal came from test scene 0 before ``final_scene``
 # (the first scene that can show the intention) was recorded.
 REDEFINED_IN_FORMAT_3 = {"final_z": "final_scene", "final_goal": "final_scene"}
+# Options added within format 3, with the value that records written before them ran with.
+OPTIONS_ADDED = {"scenes": "sampled"}
+
+
+def migrated(record: dict) -> dict:
+    """A record as this code writes it: options added since it was written get the value it ran
+    with, and the plug-in files are left out (where a method's code was loaded from describes the
+    run, not the episode: experiments moved from examples/ to experiments/)."""
+    options = record.get("config", {}).get("options")
+    if options is None:
+        return record
+    options = {**OPTIONS_ADDED, **options}
+    options.pop("plugins", None)
+    return {**record, "config": {**record["config"], "options": options}}
 
 
 class StaleFolder(ValueError):
@@ -87,7 +101,7 @@ def verify(folder: Path, sample: int, methods: list[str] | None = None) -> list[
     for rec in sample_records(records, sample):
         item = WorkItem(method=rec["method"], intention=rec["intention"], trial=rec["trial"])
         again = run_item(item, options.run, options.seed, str(folder), keep=False)
-        changed = differences(rec, again)
+        changed = differences(migrated(rec), migrated(again))
         if changed:
             diffs.append({"method": item.method, "intention": item.intention, "trial": item.trial, "changed": changed})
     return diffs
@@ -98,13 +112,63 @@ def _short(value) -> str:
     return text if len(text) <= 90 else text[:87] + "..."
 
 
+def committed_folders(root: Path) -> list[Path]:
+    """Every committed results folder that ``bench`` wrote: docs/results/* (the headline ones)
+    and experiments/*/results/* (each experiment's)."""
+    found = [*(root / "docs" / "results").glob("*/bench.json"), *(root / "experiments").glob("*/results/*/bench.json")]
+    return sorted(p.parent for p in found if (p.parent / "results.jsonl").is_file())
+
+
+def methods_of(folder: Path) -> list[str]:
+    from activeintent.results import read_results
+
+    return sorted({r["method"] for r in read_results(folder / "results.jsonl") if not r.get("error")})
+
+
+def _report(folder: Path, diffs: list[dict], sample: int) -> bool:
+    for d in diffs:
+        typer.echo(f"{d['method']} · {d['intention']} · trial {d['trial']}:")
+        for key, (recorded, again) in d["changed"].items():
+            typer.echo(f"  {key}\n    recorded: {_short(recorded)}\n    re-run:   {_short(again)}")
+    if diffs:
+        typer.echo(f"{len(diffs)} of {sample} re-run episodes differ from {folder}/results.jsonl", err=True)
+        return False
+    typer.echo(f"{sample} re-run episodes agree with {folder}/results.jsonl")
+    return True
+
+
 def bench_verify(
-    folder: Annotated[Path, typer.Argument(help="A results folder written by `bench`")],
+    folder: Annotated[Path | None, typer.Argument(help="A results folder written by `bench`")] = None,
     sample: Annotated[int, typer.Option(min=1, help="Episodes to re-run (spread over the methods)")] = 4,
     methods: Annotated[str, typer.Option(help="Only these methods (comma-separated)")] = "",
+    every: Annotated[bool, typer.Option("--all", help="Every committed folder (docs/results/*, experiments/*/results/*), "
+                                        "one episode of every method each (run from the repository's root)")] = False,
 ) -> None:
     """Re-run a sample of a results folder and compare; exit 1 when the code no longer gives
     the recorded results, 2 when the folder cannot be verified."""
+    if every:
+        folders = committed_folders(Path.cwd())
+        if not folders:
+            typer.echo("error: no committed results folders here (run from the repository's root)", err=True)
+            raise typer.Exit(2)
+        bad, stale = [], []
+        for i, f in enumerate(folders, 1):
+            typer.echo(f"[{i}/{len(folders)}] {f}")
+            n = len(methods_of(f))
+            try:
+                ok = _report(f, verify(f, n), n)
+            except StaleFolder as err:
+                typer.echo(f"  cannot be verified: {err}")
+                stale.append(f)
+                continue
+            if not ok:
+                bad.append(f)
+        typer.echo(f"{len(folders) - len(bad) - len(stale)} folders agree, {len(bad)} differ, "
+                   f"{len(stale)} cannot be verified")
+        raise typer.Exit(1 if bad else 0)
+    if folder is None:
+        typer.echo("error: give a results folder, or --all", err=True)
+        raise typer.Exit(2)
     if not (folder / "bench.json").is_file():
         typer.echo(f"error: {folder} has no bench.json (not a results folder written by `bench`)", err=True)
         raise typer.Exit(2)
@@ -113,11 +177,5 @@ def bench_verify(
     except StaleFolder as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(2) from None
-    for d in diffs:
-        typer.echo(f"{d['method']} · {d['intention']} · trial {d['trial']}:")
-        for key, (recorded, again) in d["changed"].items():
-            typer.echo(f"  {key}\n    recorded: {_short(recorded)}\n    re-run:   {_short(again)}")
-    if diffs:
-        typer.echo(f"{len(diffs)} of {sample} re-run episodes differ from {folder}/results.jsonl", err=True)
+    if not _report(folder, diffs, sample):
         raise typer.Exit(1)
-    typer.echo(f"{sample} re-run episodes agree with {folder}/results.jsonl")

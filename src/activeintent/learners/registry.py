@@ -24,7 +24,8 @@ def _bayes(signal: str, kind: str = "eig") -> Callable[[LearnerContext], Learner
         )
 
         cls = {"eig": BayesLearner, "random": RandomQueryLearner, "zero": ZeroSignalLearner}[kind]
-        return cls(signal, rng=ctx.learner_seed, llm=ctx.llm, config=BayesConfig(prior=ctx.config.prior))  # type: ignore[arg-type]
+        config = BayesConfig(prior=ctx.config.prior, scenes=ctx.config.scenes)  # type: ignore[arg-type]
+        return cls(signal, rng=ctx.learner_seed, llm=ctx.llm, config=config)
 
     return build
 
@@ -72,22 +73,20 @@ METHODS.register("random-query", lambda: Method("stop", False, _bayes("stop", "r
 METHODS.register("random-query-preference", lambda: Method("preference", False, _bayes("preference", "random"),
                  "baseline: bayes-preference's belief update with random A/B queries", "baseline"))
 
-def _lang(signal: str, prefix: str = "lang") -> Method:  # the builder lives in learners/lang
+def _lang(signal: str) -> Method:  # the builder lives in learners/lang
     from activeintent.learners.lang.learner import lang_method
 
-    return lang_method(signal, prefix)
+    return lang_method(signal)
 
 
 METHODS.register("lang-stop", lambda: _lang("stop"))
 METHODS.register("lang-preference", lambda: _lang("preference"))
-METHODS.register("decide-stop", lambda: _lang("stop", "decide"))
-METHODS.register("decide-preference", lambda: _lang("preference", "decide"))
 
-def _reward(signal: str, planner: bool = True) -> Callable[[LearnerContext], Learner]:
+def _reward(signal: str) -> Callable[[LearnerContext], Learner]:
     def build(ctx: LearnerContext) -> Learner:
-        from activeintent.learners.reward.learner import RewardConfig, RewardLearner
+        from activeintent.learners.reward.learner import RewardLearner
 
-        return RewardLearner(signal, rng=ctx.learner_seed, config=RewardConfig(planner=planner))
+        return RewardLearner(signal, rng=ctx.learner_seed)
 
     return build
 
@@ -96,8 +95,6 @@ for _signal in ("preference", "stop"):
     METHODS.register(f"reward-{_signal}", lambda s=_signal: Method(s, False, _reward(s), (
         f"peer: APReL-style reward learning, w·φ(state) over 307 relation features, {s} queries by "
         "mutual information (candidates include the Bayesian planner on its prior)"), "peer"))
-    METHODS.register(f"reward-{_signal}-noplanner", lambda s=_signal: Method(s, False, _reward(s, False), (
-        f"ablation of reward-{s}: candidates without the Bayesian planner"), "peer"))
 
 PAPER_METHODS = ("preference", "mllm", "mllm-llm")
 BASELINES = ("zero-signal", "random-query", "random-query-preference")

@@ -17,9 +17,7 @@ description of the most probable hypothesis.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
 from dataclasses import dataclass, field
-from typing import Literal
 
 import numpy as np
 from pydantic import BaseModel, Field
@@ -27,31 +25,12 @@ from pydantic import BaseModel, Field
 from activeintent import ranking
 from activeintent.goals.facts import facts
 from activeintent.learners.base import Estimate, Learner, RoundRecord
-from activeintent.learners.bayes.acquisition import (
-    Query,
-    Scored,
-    look_particles,
-    particles,
-    select_query,
-    stack_tables,
-    two_step,
-)
+from activeintent.learners.bayes.acquisition import Query, p_answered, p_new_scene, select_query
 from activeintent.learners.bayes.belief import Belief, Prior
-from activeintent.learners.bayes.candidates import (
-    candidate_plans,
-    chained_plans,
-    predict,
-    split_plans,
-)
-from activeintent.learners.bayes.decision import (
-    DecisionTable,
-    classes_of,
-    decision_table,
-    deployment_states,
-)
-from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space, random_scene
+from activeintent.learners.bayes.candidates import candidate_plans, predict
+from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space
 from activeintent.learners.bayes.judge import HypothesisJudge
-from activeintent.learners.bayes.needs import Needs, p_answered, p_new_scene
+from activeintent.learners.bayes.scenes import SCENE_DESIGNS, SceneDesign
 from activeintent.llm.base import ChatModel, ModelError
 from activeintent.signals import Answer, Signal, get_signal
 from activeintent.world import (
@@ -77,28 +56,11 @@ class BayesConfig(BaseModel):
     prior: Prior = Field("length", description="length: P(z) ∝ 2^-L(z); uniform: the ablation")
     choose: str = Field("eig", description="eig: largest expected information gain; random: the baseline")
     n_scenes: int = Field(4, ge=1, description="candidate scenes scored per design_scene")
-    scenes: Literal["random", "belief", "needs"] = Field(
-        "random", description="random: n_scenes random scenes; belief: the n_scenes of scene_candidates random "
-        "ones that the belief most expects to show its goals, also after a 'new scene' answer; needs: as belief, "
-        "each candidate drawn to also meet a requirement drawn from the needs belief")
+    scenes: SceneDesign = Field(
+        "sampled", description="how the candidate scenes are chosen (scenes.py): sampled: n_scenes random "
+        "scenes; belief: the n_scenes of scene_candidates random ones that the belief most expects to show "
+        "its goals, also after a 'new scene' answer")
     scene_candidates: int = Field(16, ge=1, description="scenes drawn per design_scene when scenes = belief")
-    gain: Literal["goal", "shown", "decision", "shown-decision", "value"] = Field(
-        "goal", description="goal: EIG about z, the 'new scene' answer included; shown: only what the "
-        "answers to the shown trajectories tell (the feasibility part of the EIG left out); decision: "
-        "information about which plans to run on scenes of the public test distribution (decision.py); "
-        "shown-decision: only what the answers to the shown trajectories tell about that; value: the expected "
-        "success of the final answer on those scenes after the answer (decision.decision_value)")
-    deploy_scenes: int = Field(8, ge=1, description="gain = decision: the learner's own scenes of the test distribution")
-    needs: bool = Field(False, description="also learn what the intention needs of a scene's objects from "
-                        "'new scene' answers (needs.py)")
-    needs_counts: bool = Field(False, description="the needs belief also has literals counting the blocks a "
-                               "selector of the goal language picks ('at least two cool blocks', needs.py)")
-    chains: int = Field(0, ge=0, description="stop queries: also offer plans of one of this many likely z "
-                        "followed by another's (candidates.chained_plans); 0: none")
-    split: int = Field(0, ge=0, description="stop queries: also offer this many plans grown step by step so "
-                       "that each step moves away from about half of the likely z left (candidates.split_plans); 0: none")
-    lookahead: int = Field(1, ge=1, le=2, description="1: the query whose answer tells most; 2: the one whose "
-                           "answer and the best next query's tell most together (acquisition.two_step)")
     top_k: int = Field(16, ge=1, description="plans come from this many most probable hypotheses")
     explore: int = Field(6, ge=0, description="... plus this many random other hypotheses")
     max_plans: int = Field(36, ge=2, description="candidate plans per scene")
@@ -119,7 +81,6 @@ class Observation:
     answer: Answer
     shown: list[Trajectory]
     texts: list[str] = field(default_factory=list)  # what was shown, in words (for proposals)
-    refuse: float = 0.0  # q(s) when answered: the needs belief's P(the scene lacks what is needed)
 
     @property
     def finals(self):
@@ -154,15 +115,10 @@ class BayesLearner(Learner):
         self.answer_log: list[dict] = []  # diagnostics(): one entry per answer
         self.prior_entropy = self.belief.entropy_bits()
         self._drained = 0
-        self._classes: tuple[tuple[int, int], np.ndarray, DecisionTable] | None = None
-        self._look_pool: list[np.ndarray] = []  # this round's query tables (lookahead; cleared at each answer)
-        self.needs = Needs(self.config.new_scene_error, self.config.needs_counts) if self.config.needs else None
-        self.deploy = (deployment_states(int(self.rng.integers(2**31)), self.config.deploy_scenes)
-                       if self._deciding() else [])
 
     @property
     def redesigns_after_new_scene(self) -> bool:  # type: ignore[override]
-        return self.config.scenes != "random"
+        return SCENE_DESIGNS[self.config.scenes].after_new_scene
 
     # ---- belief views ----
 
@@ -203,125 +159,33 @@ class BayesLearner(Learner):
 
     # ---- queries ----
 
-    def _select(self, state: WorldState, scored: list[Scored] | None = None) -> Query | None:
+    def _select(self, state: WorldState) -> Query | None:
         c = self.config
         feasible = self.judge.feasible(tuple(state.positions))
         outs = candidate_plans(self.hyps, self.weights, state, self.rng, top_k=c.top_k, explore=c.explore,
                                prefixes=self.sig.shows > 1, limit=c.max_plans, feasible=feasible)
         feasible = self.judge.feasible(tuple(state.positions))  # the planner may have found some z infeasible
-        if c.chains and self.sig.shows == 1:
-            outs += chained_plans(self.hyps, self.weights, state, feasible, first=c.chains,
-                                  seen={o.key for o in outs})
-            feasible = self.judge.feasible(tuple(state.positions))
-        if c.split and self.sig.shows == 1:
-            outs += split_plans(self.hyps, self.weights, state, feasible, self.judge,
-                                particles(self.weights, mass=0.99, cap=256), starts=c.split,
-                                seen={o.key for o in outs},
-                                classes=self.decision_classes() if self._deciding() else None)
-            feasible = self.judge.feasible(tuple(state.positions))
         return select_query(self.sig, self.model, self.judge, self.weights, feasible, outs,
-                            c.new_scene_error, self.rng, choose=c.choose, gain=c.gain,
-                            classes=self.decision_classes() if self._deciding() else None,
-                            refuse=self.refuse(tuple(state.positions)), scored=scored,
-                            table=self.decision_table() if c.gain == "value" else None)
-
-    def _looking(self) -> bool:
-        return self.config.lookahead == 2 and self.config.choose == "eig"
-
-    def _two_step(self, scored: list[Scored], pool: list[np.ndarray]) -> tuple[int, Query]:
-        """The two-step lookahead's choice among ``scored`` against the query ``pool`` (acquisition.two_step)."""
-        look = look_particles(self.weights)
-        classes = self.decision_classes()[look] if self._deciding() else np.arange(len(look))
-        i, j, value = two_step(scored, stack_tables(pool), self.weights[look], classes)
-        sc = scored[i]
-        alternatives = [{"plans": [describe_plan(sc.outs[k].plan) for k in sc.combos[j]], "lookahead_nats": round(value, 4),
-                         "note": "chosen by the two-step value; eig_nats is its one-step gain"}]
-        return i, Query([sc.outs[k] for k in sc.combos[j]], float(sc.gains[j]), alternatives)
-
-    def refuse(self, objects: tuple[str, ...]) -> float:
-        """q(s): P(the scene lacks what the intention needs) under the needs belief (0 without one)."""
-        return 0.0 if self.needs is None else self.needs.refuse(objects)
-
-    def _deciding(self) -> bool:
-        return self.config.gain.endswith("decision") or self.config.gain == "value"
-
-    def decision_classes(self) -> np.ndarray:
-        """z grouped by the plans that satisfy them on the learner's deployment scenes (once per
-        belief: the answers so far and the size of H key it)."""
-        return self._decision()[0]
-
-    def decision_table(self) -> DecisionTable:
-        """Which candidate plans satisfy each z on the learner's deployment scenes (decision.py)."""
-        return self._decision()[1]
-
-    def _decision(self) -> tuple[np.ndarray, DecisionTable]:
-        key = (len(self.observations), len(self.hyps))
-        if self._classes is None or self._classes[0] != key:
-            rng = np.random.default_rng(list(key))  # not the learner's stream: a cache must not move it
-            table = decision_table(self.hyps, self.weights, self.judge, self.deploy, rng,
-                                   top_k=self.config.final_top_k, limit=self.config.max_plans)
-            self._classes = (key, classes_of(table, len(self.hyps)), table)
-        return self._classes[1], self._classes[2]
+                            c.new_scene_error, self.rng, choose=c.choose)
 
     def shown_mass(self, scene: Scene) -> float:
         """Σ_z w_z 1[z can be shown in ``scene``]: the belief's chance that the user answers
         about the trajectories rather than "new scene"."""
         return float(self.weights @ self.judge.feasible(tuple(scene.objects)))
 
-    def _scene_candidates(self) -> Iterator[Scene]:
-        """Lazily: with random scenes each draw is followed by its layout's, in the learner's stream.
-        ``scenes = belief``: each candidate is a random scene that can show a z drawn from the
-        belief (up to 20 draws); kept are the n_scenes that can show the most of the likely z
-        (those holding 99 % of the belief, at most 64)."""
-        c = self.config
-        if c.choose == "random" or c.scenes == "random":
-            for _ in range(1 if c.choose == "random" else c.n_scenes):
-                yield random_scene(self.rng)
-            return
-        likely = particles(self.weights, mass=0.99, cap=64)
-        w = self.weights[likely] / self.weights[likely].sum()
-        drawn = []
-        for _ in range(c.scene_candidates):
-            z = self.hyps[likely[int(self.rng.choice(len(likely), p=w))]]
-            need = self.needs.draw(self.rng) if c.scenes == "needs" and self.needs is not None else None
-            for _ in range(20):
-                scene = random_scene(self.rng)
-                objects = tuple(scene.objects)
-                if z.can_show(objects) and (need is None or not self.needs.fails(objects)[need]):  # type: ignore[union-attr]
-                    break
-            drawn.append(scene)
-        mass = np.array([(1 - self.refuse(tuple(s.objects)))
-                         * sum(w[j] for j, i in enumerate(likely) if self.hyps[i].can_show(tuple(s.objects)))
-                         for s in drawn])
-        keep = ranking.order(mass)[:c.n_scenes]  # most likely to be shown; ties to the first drawn
-        yield from (drawn[i] for i in sorted(keep))
-
     def design_scene(self) -> Scene | None:
         """The candidate scene (3–5 objects, from the learner's own rng) whose best query has
-        the largest information gain (``scenes = belief``: among those the belief most expects
-        to be able to show its goals)."""
+        the largest information gain; the candidates come from the ``scenes`` strategy."""
         best: tuple[Scene, Query] | None = None
-        looked: list[tuple[Scene, Scored]] = []
-        for scene in self._scene_candidates():
-            scored: list[Scored] | None = [] if self._looking() else None
-            q = self._select(WorldState(positions=layout(scene, int(self.rng.integers(2**31)))), scored)
-            if scored:
-                looked.append((scene, scored[0]))
+        for scene in SCENE_DESIGNS[self.config.scenes].candidates(self):
+            q = self._select(WorldState(positions=layout(scene, int(self.rng.integers(2**31)))))
             if q is not None and (best is None or ranking.greater(q.gain, best[1].gain)):
                 best = (scene, q)
-        if looked:  # lookahead: the next query may come from any scene of this round
-            pool = [t for _, sc in looked for t in sc.tables]
-            self._look_pool = pool
-            i, q = self._two_step([sc for _, sc in looked], pool)
-            best = (looked[i][0], q)
         self.designed = best
         return best[0] if best else None
 
     def estimate(self, scene: Scene, state: WorldState) -> Estimate:
-        scored: list[Scored] | None = [] if self._looking() else None
-        q = self._select(state, scored)  # the real layout: re-select for it
-        if scored:  # lookahead: against this layout's queries and those of the round's design
-            q = self._two_step(scored, scored[0].tables + self._look_pool)[1]
+        q = self._select(state)  # the real layout: re-select for it
         top, w = self.top()[0]
         if q is None:
             plan = top.plan(state) or []
@@ -339,10 +203,10 @@ class BayesLearner(Learner):
     def _likelihood(self, obs: Observation, hyps: tuple[Hypothesis, ...], judge_) -> np.ndarray:
         feasible = judge_.feasible(obs.scene.objects)
         e = self.config.new_scene_error
-        if obs.answer.new_scene:  # with a needs belief that doubts the scene, it says less about z
-            return p_new_scene(feasible, e, obs.refuse)
+        if obs.answer.new_scene:
+            return p_new_scene(feasible, e)
         lik = self.sig.likelihood(obs.answer, obs.shown, judge_, self.model)
-        return lik * p_answered(feasible, e, obs.refuse)
+        return lik * p_answered(feasible, e)
 
     def _log_lik(self, judge: HypothesisJudge) -> np.ndarray:
         """Σ_k log P(h_k | z) over every answer so far, for the hypotheses ``judge`` judges
@@ -359,14 +223,11 @@ class BayesLearner(Learner):
         texts = ([f"{k}: {describe_state(t.outcome)}" for k, t in zip("AB", trajectories, strict=False)]
                  if self.sig.shows > 1 else
                  [f"step {s.index + 1}: {describe_skill(s.skill)}" for t in trajectories for s in t.steps])
-        obs = Observation(record.scene, answer, list(trajectories), texts, self.refuse(tuple(record.scene.objects)))
-        self._look_pool = []  # the round is over: its queries are not the next round's
+        obs = Observation(record.scene, answer, list(trajectories), texts)
         lik = self._likelihood(obs, self.hyps, self.judge)
         before = self.weights
         shown = self.shown_mass(record.scene)
         evidence = self.belief.update(lik)
-        if self.needs is not None:
-            self.needs.update(tuple(record.scene.objects), answer.new_scene, shown)
         gain = record.estimate.why.get("eig_nats") if record.estimate is not None else None
         self.answer_log.append({
             "answer": answer.kind,
@@ -374,7 +235,6 @@ class BayesLearner(Learner):
             "gain_bits": None if gain is None else round(gain / math.log(2), 4),  # what the query promised
             "shown_mass": round(shown, 4),  # the belief's P(the scene can show z) before the answer
             "top": [(h.name, round(p, 4)) for h, p in self.top(3)],
-            **({} if self.needs is None else {"refuse": round(obs.refuse, 4), "needs": self.needs.top(2)}),
         })
         self.observations.append(obs)
         surprised = not answer.new_scene and evidence < self.config.surprise * float(lik.max())

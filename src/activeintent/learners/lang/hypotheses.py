@@ -20,7 +20,7 @@ import numpy as np
 
 from activeintent.goals import planner
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import Goal, all_clauses
+from activeintent.goals.language import Goal
 from activeintent.intentions.base import Intention
 from activeintent.learners.bayes.hypotheses import Hypothesis, random_scene
 from activeintent.learners.lang.space import Compiled, goal_space
@@ -153,16 +153,6 @@ class GoalIntention(Intention):
 
 
 _SPACES: dict[tuple[int, int], LangSpace] = {}
-_POOLS: dict[float, LangSpace] = {}
-
-
-def one_clause_pool(cut: float) -> LangSpace:
-    """Every one-clause goal of the language, with and without "every other block stays", that
-    is longer than ``cut`` bits (built once per process; learners reset its planner verdicts)."""
-    key = round(cut, 6)
-    if key not in _POOLS:
-        _POOLS[key] = LangSpace([g for c in all_clauses() for g in (Goal((c,)), Goal((c,), True)) if g.bits > cut])
-    return _POOLS[key]
 
 
 def lang_space(seed: int = 0, keep: int = 3000) -> LangSpace:

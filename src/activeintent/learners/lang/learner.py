@@ -9,25 +9,14 @@ their prior 2^-L(z) and their likelihood on every answer so far.
 
 from __future__ import annotations
 
-from itertools import combinations
-
 import numpy as np
 from pydantic import Field
 
-from activeintent import ranking
-from activeintent.goals import planner
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import Goal
 from activeintent.learners.base import LearnerContext, Method, RoundRecord
-from activeintent.learners.bayes.candidates import predict
 from activeintent.learners.bayes.judge import HypothesisJudge, trajectory_steps, utility
 from activeintent.learners.bayes.learner import BayesConfig, BayesLearner
-from activeintent.learners.lang.hypotheses import (
-    LangHypothesis,
-    LangSpace,
-    lang_space,
-    one_clause_pool,
-)
+from activeintent.learners.lang.hypotheses import LangHypothesis, LangSpace, lang_space
 from activeintent.learners.lang.proposals import neighbours, propose_goals
 from activeintent.llm.base import ModelError
 from activeintent.world import WorldState
@@ -98,11 +87,6 @@ class LangConfig(BayesConfig):
     join_partners: int = Field(32, ge=0, description="... and each of them joined with each of this many likely goals")
     max_added: int = Field(20000, ge=0, description="goals added in one episode at most")
     proposals_per_call: int = Field(3, ge=1, le=5, description="goals asked of the model per call")
-    final_joint: int = Field(0, ge=0, le=8, description="the final answer may also run a plan for both "
-                             "goals of any pair of this many likely goals (0: off): one plan can satisfy two z")
-    pool: int = Field(0, ge=0, description="after each answer, this many one-clause goals longer than the "
-                      "start space's join: those with the largest prior × likelihood of every answer so far "
-                      "among all one-clause goals of the language (0: off)")
 
 
 class LangLearner(BayesLearner):
@@ -128,12 +112,6 @@ class LangLearner(BayesLearner):
         self.cut = max(h.bits for h in hyps) + 1e-9  # the starting space holds every distinct goal up to here
         self.growth = {"neighbours": 0, "model_answers": 0, "model_fit": 0, "model_new": 0}
         self.model_goals: set[str] = set()
-        if config.pool:  # every one-clause goal above the cut, scored on each answer as it comes
-            self.pool = one_clause_pool(self.cut)
-            self.pool.reset()
-            self.pool_judge = LangJudge(self.pool)
-            self.pool_log_post = -np.array([g.bits for g in self.pool.goals]) * np.log(2)  # up to a constant
-            self.growth["pool"] = 0
 
     # ---- growing the space ----
 
@@ -185,46 +163,13 @@ class LangLearner(BayesLearner):
         self.growth["model_new"] += len(added)
         return added
 
-    def _from_pool(self) -> int:
-        """The ``pool`` one-clause goals with the largest prior × likelihood join (those held
-        already are skipped by _admit)."""
-        lik = self._likelihood(self.observations[-1], self.pool_judge.hyps, self.pool_judge)
-        self.pool_log_post = self.pool_log_post + np.log(np.clip(lik, 1e-300, None))
-        best = ranking.order(self.pool_log_post)[:self.config.pool]
-        added = self._admit([self.pool.goals[i] for i in best])
-        self.growth["pool"] += len(added)
-        return len(added)
-
     def observe(self, record: RoundRecord, trajectories: list[Trajectory]) -> str | None:
         out = super().observe(record, trajectories)  # Bayes' rule, then model proposals (if any)
         if record.answer is not None:
             n = self._rejuvenate()
             if self.log:
                 self.log[-1]["neighbours_added"] = n
-            if self.config.pool:
-                pooled = self._from_pool()
-                if self.log:
-                    self.log[-1]["pool_added"] = pooled
         return out
-
-    def final_outcomes(self, state: WorldState, w: np.ndarray, feasible: np.ndarray) -> list:
-        """Bayes' decision over more plans: besides each likely goal's own plans, a plan for
-        the conjunction of two likely goals (their clauses together), so that a belief split
-        between compatible goals can be answered by a plan that satisfies both; every plan is
-        still chosen by its expected success Σ_z w_z 1[z holds after it]."""
-        outs = super().final_outcomes(state, w, feasible)
-        m = self.config.final_joint
-        if m < 2:
-            return outs
-        likely = [self.hyps[i].goal for i in ranking.order(w, ranking.WEIGHT_DECIMALS)[:m] if w[i] > 0]
-        planned = {repr(o.plan) for o in outs}
-        for a, b in combinations(likely, 2):
-            joint = Goal(tuple(dict.fromkeys(a.clauses + b.clauses)), a.stays or b.stays)
-            plan = planner.plan(joint, state)
-            if plan and repr(plan) not in planned:
-                planned.add(repr(plan))
-                outs.append(predict(state, plan))
-        return outs
 
     def mass_of(self, key: str) -> float:
         """w of the goal with this key (0 when the belief does not hold it)."""
@@ -246,24 +191,11 @@ class LangLearner(BayesLearner):
         return out
 
 
-# ``decide-<signal>``: questions about what the robot will do (issue "Questions worth a person's
-# answer"): scenes the belief expects to show its goals, queries scored by what their answer
-# tells about the decision (examples/decide_ablation.py switches each part off).
-DECIDE = {"scenes": "belief", "gain": "decision", "needs": True}
-
-
-def lang_method(signal: str, prefix: str = "lang"):
-    """The registry entry of ``lang-<signal>`` or ``decide-<signal>`` (built from a
-    LearnerContext like ``bayes``)."""
-    settings = DECIDE if prefix == "decide" else {}
+def lang_method(signal: str) -> Method:
+    """The registry entry of ``lang-<signal>`` (built from a LearnerContext like ``bayes``)."""
 
     def build(ctx: LearnerContext) -> LangLearner:
-        learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm,
-                              config=LangConfig(prior=ctx.config.prior, **settings))  # type: ignore[arg-type]
-        learner.name = f"{prefix}-{signal}"
-        return learner
+        return LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm,
+                           config=LangConfig(prior=ctx.config.prior, scenes=ctx.config.scenes))  # type: ignore[arg-type]
 
-    if prefix == "decide":
-        return Method(signal, False, build, f"ours: the goal-language belief, scenes designed from it, {signal} "
-                      "queries by information about the decision")
     return Method(signal, False, build, f"ours: growing belief over the goal language, {signal} queries by EIG")

@@ -54,7 +54,7 @@ class RewardConfig(BaseModel):
     final_depth: int = Field(4, ge=0, description="steps of greedy ascent on E[w]·φ for the final answer")
     features: tuple[int, ...] | None = Field(None, description="indices of FEATURE_NAMES to use (None: all)")
     prior: str = Field("uniform", description="prior over w: uniform on the sphere (APReL's) | heavy-tailed "
-                       "(few heavily weighted features as likely as many light ones; examples/reward_prior.py)")
+                       "(few heavily weighted features as likely as many light ones; experiments/reward-variants/heavy_tailed.py)")
     model: RewardModel = Field(default_factory=RewardModel)
 
 

@@ -1,0 +1,22 @@
+"""Ablation of ``reward-<signal>``: the peer without the Bayesian planner's candidate plans.
+
+    bin/activeintent bench --plugin experiments/reward-variants/noplanner.py --methods reward-preference-noplanner,reward-preference ...
+
+``reward-<signal>-noplanner`` proposes only random skill sequences and greedy one-feature plans
+(APReL's own kind of candidates); the product's peer also offers the plans of the Bayesian
+learners on their prior (docs/reward.md).
+"""
+
+from activeintent.learners.registry import METHODS, LearnerContext, Method
+from activeintent.learners.reward.learner import RewardConfig, RewardLearner
+
+
+def _noplanner(signal: str) -> Method:
+    def build(ctx: LearnerContext) -> RewardLearner:
+        return RewardLearner(signal, rng=ctx.learner_seed, config=RewardConfig(planner=False))
+
+    return Method(signal, False, build, f"ablation of reward-{signal}: candidates without the Bayesian planner", "peer")
+
+
+for _signal in ("preference", "stop"):
+    METHODS.register(f"reward-{_signal}-noplanner", lambda s=_signal: _noplanner(s))
