@@ -22,6 +22,7 @@ _COMMAND_MODULES = (
     "activeintent.bench.commands",
     "activeintent.bench.perf",
     "activeintent.bench.verify",
+    "activeintent.goals.commands",
     "activeintent.intentions.commands",
     "activeintent.learners.commands",
     "activeintent.learners.bayes.commands",

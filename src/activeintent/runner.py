@@ -64,6 +64,13 @@ def check_spec(spec: RunSpec) -> None:
     for path in spec.plugins:
         load_plugin(path)
     method = get_method(spec.learner.method)
+    if spec.learner.prior not in ("length", "uniform"):
+        from activeintent.goals.prior import load_prior
+
+        if not method.goal_language:
+            raise ValueError(f"--prior {spec.learner.prior}: a fitted prior is over the goal language; "
+                             f"{spec.learner.method} takes length or uniform (lang-* take fitted and file:PATH)")
+        load_prior(spec.learner.prior)  # a missing or malformed file is refused before any work
     ENVS.check(spec.env.name)
     USER_PRESETS.check(spec.user.preset)
     if method.needs_llm and spec.models.llm == "none":

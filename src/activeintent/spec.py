@@ -97,7 +97,8 @@ class LearnerConfig(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     method: str = DEFAULT_METHOD
-    prior: str = Field("length", pattern="^(length|uniform)$")
+    prior: str = Field("length", pattern="^(length|uniform|fitted|file:.+)$",
+                       description="length | uniform | fitted (lang-* only) | file:PATH (lang-*, from `prior fit`)")
     scenes: str = Field("sampled", pattern="^(sampled|belief)$",
                         description="bayes-* and lang-*: sampled scenes, or scenes the belief expects to show z")
     epsilon: float = Field(2.0, ge=0, description="ε: seconds before the stop for image I_b")

@@ -107,6 +107,7 @@ class Method:
     build: Callable[[LearnerContext], Learner]
     help: str = ""
     family: str = "ours"  # paper | ours | baseline
+    goal_language: bool = False  # its hypotheses are goals of the language: --prior fitted / file: apply
 
     def __call__(self, ctx: LearnerContext) -> Learner:
         if self.needs_llm and ctx.llm is None:

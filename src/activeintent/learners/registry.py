@@ -82,6 +82,15 @@ def _lang(signal: str) -> Method:  # the builder lives in learners/lang
 METHODS.register("lang-stop", lambda: _lang("stop"))
 METHODS.register("lang-preference", lambda: _lang("preference"))
 
+
+def _lang_zero() -> Method:
+    from activeintent.learners.lang.learner import lang_zero_signal
+
+    return lang_zero_signal()
+
+
+METHODS.register("lang-zero-signal", _lang_zero)
+
 def _reward(signal: str) -> Callable[[LearnerContext], Learner]:
     def build(ctx: LearnerContext) -> Learner:
         from activeintent.learners.reward.learner import RewardLearner
@@ -97,7 +106,7 @@ for _signal in ("preference", "stop"):
         "mutual information (candidates include the Bayesian planner on its prior)"), "peer"))
 
 PAPER_METHODS = ("preference", "mllm", "mllm-llm")
-BASELINES = ("zero-signal", "random-query", "random-query-preference")
+BASELINES = ("zero-signal", "lang-zero-signal", "random-query", "random-query-preference")
 
 
 def _derived() -> dict[str, str]:

@@ -2,7 +2,9 @@
 
 Prior (``prior="length"``): P(z) ∝ 2^(−L(z)), L the description length in bits of z in the
 grammar (docs/bayes.md) — a general simplicity principle, not a choice of intentions.
-``prior="uniform"`` is the ablation.
+``prior="uniform"`` is the ablation. The goal language's hypotheses may carry bits under a
+prior fitted to a corpus of requests (goals/prior.py: ``fitted``, ``file:PATH``): P(z) ∝ 2^(−bits)
+reads them the same way.
 """
 
 from __future__ import annotations
@@ -18,16 +20,17 @@ from activeintent.learners.bayes.hypotheses import Hypothesis
 Prior = Literal["length", "uniform"]
 
 
-def raw_log_prior(hyps: tuple[Hypothesis, ...], prior: Prior = "length") -> np.ndarray:
-    """log P(z) up to one constant: −L(z) ln 2 (length) or 0 (uniform)."""
+def raw_log_prior(hyps: tuple[Hypothesis, ...], prior: str = "length") -> np.ndarray:
+    """log P(z) up to one constant: −L(z) ln 2 (length, or the fitted prior the hypotheses'
+    bits were computed under) or 0 (uniform)."""
     if prior == "uniform":
         return np.zeros(len(hyps))
-    if prior == "length":
+    if prior in ("length", "fitted") or prior.startswith("file:"):
         return -np.array([h.bits for h in hyps]) * math.log(2)
-    raise ValueError(f"unknown prior {prior!r}; valid priors: length, uniform")
+    raise ValueError(f"unknown prior {prior!r}; valid priors: length, uniform, fitted, file:PATH")
 
 
-def log_prior(hyps: tuple[Hypothesis, ...], prior: Prior = "length") -> np.ndarray:
+def log_prior(hyps: tuple[Hypothesis, ...], prior: str = "length") -> np.ndarray:
     lw = raw_log_prior(hyps, prior)
     return lw - np.logaddexp.reduce(lw)
 
@@ -35,7 +38,7 @@ def log_prior(hyps: tuple[Hypothesis, ...], prior: Prior = "length") -> np.ndarr
 class Belief:
     """w_z ∝ P(z) Π_k P(h_k | z), kept in logs."""
 
-    def __init__(self, hyps: tuple[Hypothesis, ...], prior: Prior = "length"):
+    def __init__(self, hyps: tuple[Hypothesis, ...], prior: str = "length"):
         self.hyps = hyps
         self.prior = prior
         raw = raw_log_prior(hyps, prior)

@@ -21,6 +21,7 @@ import numpy as np
 from activeintent.goals import planner
 from activeintent.goals.facts import Facts, facts
 from activeintent.goals.language import Goal
+from activeintent.goals.prior import FittedPrior, load_prior
 from activeintent.intentions.base import Intention
 from activeintent.learners.bayes.hypotheses import Hypothesis, random_scene
 from activeintent.learners.lang.space import Compiled, goal_space
@@ -30,8 +31,9 @@ from activeintent.world import Scene, Skill, WorldState
 class LangSpace:
     """A tuple of goals, their shared vectorised judge and the planner verdicts so far."""
 
-    def __init__(self, goals: list[Goal] | tuple[Goal, ...], variants: int = 2):
+    def __init__(self, goals: list[Goal] | tuple[Goal, ...], variants: int = 2, prior: FittedPrior | None = None):
         self.goals = tuple(goals)
+        self.prior = prior  # None: the length prior (each goal's own bits)
         self.compiled = Compiled(list(self.goals))
         self.variants = variants
         self.failed: dict[tuple[str, ...], set[int]] = {}
@@ -88,7 +90,7 @@ class LangHypothesis(Hypothesis):
         self.space = space
         self.index = index
         self.clauses = ()
-        self.bits = goal.bits
+        self.bits = goal.bits if space.prior is None else space.prior.bits(goal)
         self.name = goal.key
 
     @property
@@ -152,12 +154,14 @@ class GoalIntention(Intention):
         return planner.plan(self.goal, state)
 
 
-_SPACES: dict[tuple[int, int], LangSpace] = {}
+_SPACES: dict[tuple[int, int, str], LangSpace] = {}
 
 
-def lang_space(seed: int = 0, keep: int = 3000) -> LangSpace:
-    """The language's de-duplicated hypothesis space (built once per process, cached on disk)."""
-    key = (seed, keep)
+def lang_space(seed: int = 0, keep: int = 3000, prior: str = "length") -> LangSpace:
+    """The language's de-duplicated hypothesis space: the ``keep`` most probable distinct goals
+    under ``prior`` (length, fitted or file:PATH; built once per process, cached on disk)."""
+    fitted = load_prior(prior)
+    key = (seed, keep, fitted.tag if fitted else "length")
     if key not in _SPACES:
-        _SPACES[key] = LangSpace(goal_space(seed, keep))
+        _SPACES[key] = LangSpace(goal_space(seed, keep, fitted), prior=fitted)
     return _SPACES[key]

@@ -13,6 +13,7 @@ import numpy as np
 from pydantic import Field
 
 from activeintent.goals.facts import Facts, facts
+from activeintent.goals.language import Goal
 from activeintent.learners.base import LearnerContext, Method, RoundRecord
 from activeintent.learners.bayes.judge import HypothesisJudge, trajectory_steps, utility
 from activeintent.learners.bayes.learner import BayesConfig, BayesLearner
@@ -83,6 +84,10 @@ class LangJudge(HypothesisJudge):
 class LangConfig(BayesConfig):
     """The Bayesian learner's settings plus how the space grows (none tuned to intentions)."""
 
+    prior: str = Field("length", pattern="^(length|uniform|fitted|file:.+)$",  # type: ignore[assignment]
+                       description="length: P(z) ∝ 2^-L(z); fitted: fitted to data/requests (goals/prior.py); "
+                       "file:PATH: written by `prior fit`; uniform: the ablation")
+
     rejuvenate_top: int = Field(8, ge=0, description="after each answer, neighbours of this many likely goals join")
     join_partners: int = Field(32, ge=0, description="... and each of them joined with each of this many likely goals")
     max_added: int = Field(20000, ge=0, description="goals added in one episode at most")
@@ -94,8 +99,8 @@ class LangLearner(BayesLearner):
 
     def __init__(self, signal, rng=None, llm=None, config: LangConfig | None = None,
                  hypotheses: tuple[LangHypothesis, ...] | None = None, keep: int = KEEP):
-        hyps = tuple(hypotheses or lang_space(0, keep).hypotheses)
         config = config or LangConfig()
+        hyps = tuple(hypotheses or lang_space(0, keep, config.prior).hypotheses)
         super().__init__(signal, rng, None, config, hyps)
         self.config: LangConfig = config
         self.llm = llm
@@ -106,7 +111,8 @@ class LangLearner(BayesLearner):
         for sp in spaces:
             sp.reset()  # the shared space keeps no planner verdicts from an earlier episode
         self.base = spaces
-        self.added = LangSpace([])  # goals that joined during this episode
+        self.prior = spaces[0].prior if spaces else None  # the goals' prior (None: length)
+        self.added = LangSpace([], prior=self.prior)  # goals that joined during this episode
         self.judge = LangJudge(self.base)
         self.keys = {h.name for h in hyps}
         self.cut = max(h.bits for h in hyps) + 1e-9  # the starting space holds every distinct goal up to here
@@ -120,18 +126,22 @@ class LangLearner(BayesLearner):
         room = self.config.max_added - len(self.added.goals)
         # A goal as short as the starting space's longest is in it or behaves like one of it
         # (de-duplication kept the shortest): adding it would count that behaviour twice.
-        fresh = [g for g in goals if g.key not in self.keys and g.bits > self.cut][:max(room, 0)]
+        fresh = [g for g in goals if g.key not in self.keys and self.bits(g) > self.cut][:max(room, 0)]
         if not fresh:
             return []
         n_old = len(self.added.goals)
-        self.added = LangSpace(list(self.added.goals) + fresh)
-        new_space = LangSpace(fresh)  # scored alone, then merged: the judge below is temporary
+        self.added = LangSpace(list(self.added.goals) + fresh, prior=self.prior)
+        new_space = LangSpace(fresh, prior=self.prior)  # scored alone, then merged: the judge below is temporary
         log_lik = self._log_lik(LangJudge(new_space))
         self.judge = LangJudge(self.base + [self.added])
         self.belief.extend(self.added.hypotheses[n_old:], log_lik)
         self.belief.hyps = self.judge.hyps  # the same goals, bound to the merged space
         self.keys.update(g.key for g in fresh)
         return [g.key for g in fresh]
+
+    def bits(self, goal: Goal) -> float:
+        """L(z) under the learner's prior."""
+        return goal.bits if self.prior is None else self.prior.bits(goal)
 
     def _rejuvenate(self) -> int:
         if not self.config.rejuvenate_top:
@@ -198,4 +208,19 @@ def lang_method(signal: str) -> Method:
         return LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm,
                            config=LangConfig(prior=ctx.config.prior, scenes=ctx.config.scenes))  # type: ignore[arg-type]
 
-    return Method(signal, False, build, f"ours: growing belief over the goal language, {signal} queries by EIG")
+    return Method(signal, False, build, f"ours: growing belief over the goal language, {signal} queries by EIG",
+                  goal_language=True)
+
+
+def lang_zero_signal() -> Method:
+    """``lang-zero-signal``: the goal language's prior best guess, no questions (the baseline of
+    lang-* under the same prior)."""
+
+    def build(ctx: LearnerContext) -> LangLearner:
+        learner = LangLearner("stop", rng=ctx.learner_seed, config=LangConfig(prior=ctx.config.prior))  # type: ignore[arg-type]
+        learner.asks = False
+        learner.name = "lang-zero-signal"
+        return learner
+
+    return Method("stop", False, build, "baseline: the goal language's prior best guess, asks nothing",
+                  "baseline", goal_language=True)

@@ -38,6 +38,7 @@ from activeintent.goals.language import (
     structure_judge,
 )
 from activeintent.goals.planner import generic_moves, plan
+from activeintent.goals.prior import FittedPrior
 from activeintent.learners.bayes.hypotheses import random_scene
 from activeintent.world import WorldState, apply_skill, layout
 from activeintent.world.scene import kind_of
@@ -398,11 +399,20 @@ def cached_json(path: Path, make: Callable[[], dict]) -> dict:
     return value
 
 
-def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scenes: int = 40) -> dict:
-    """Enumerate, de-duplicate, keep the ``keep`` shortest; returns keys and counts."""
+def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scenes: int = 40,
+                prior: FittedPrior | None = None) -> dict:
+    """Enumerate, de-duplicate, keep the ``keep`` shortest (under ``prior``: the most probable);
+    returns keys and counts. Pairs are formed from the simplest clauses: those up to
+    ``pair_bits`` under the length prior, or as many of the most probable under ``prior``."""
     t0 = time.time()
     scenes, states, moves = probe_bank(seed, n_scenes)
-    clauses = sorted(all_clauses(), key=lambda c: (c.bits, c.key))
+    length = prior is None
+
+    def bits(goal: Goal) -> float:
+        return goal.bits if length else prior.bits(goal)  # type: ignore[union-attr]
+
+    clauses = sorted(all_clauses(), key=lambda c: (c.bits if length else bits(Goal((c,))), c.key))
+    simple = sum(c.bits <= pair_bits for c in clauses)  # the pair pool's size under the length prior
     comp = Compiled([Goal((c,)) for c in clauses])
     n = len(clauses)
     P = np.array([comp.possible(objs)[:n] for objs in scenes]).T  # [clause, scene]
@@ -430,16 +440,16 @@ def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scen
             if cur is None or bits[i] < cur[0]:
                 best[k] = (float(bits[i]), keys[i])
 
-    single_bits = np.array([Goal((c,)).bits for c in clauses])
+    single_bits = np.array([Goal((c,)).bits for c in clauses]) if length else None
     for stays in (False, True):
         o = Off | (stays & ~In & P[:, move_scene])
         goals = [Goal((c,), stays) for c in clauses]
-        offer(single_bits + 0, [g.key for g in goals], P, H, o)
+        offer(single_bits + 0 if length else np.array([bits(g) for g in goals]), [g.key for g in goals], P, H, o)
         generated += len(goals)
     # pairs of the simplest behaviourally distinct clauses
     reps: dict[bytes, int] = {}
     for i in range(n):
-        if clauses[i].bits <= pair_bits and H[i].any():
+        if (clauses[i].bits <= pair_bits if length else i < simple) and H[i].any():
             reps.setdefault(np.packbits(np.concatenate([P[i], H[i], Off[i]])).tobytes(), i)
     idx = sorted(reps.values())
     for a_pos, a in enumerate(idx):
@@ -450,8 +460,7 @@ def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scen
         h = H[a] & H[bs]
         o = (Off[a] | Off[bs]) & p[:, move_scene]
         keys = [Goal((clauses[a], clauses[b])).key for b in bs]
-        bits = np.array([Goal((clauses[a], clauses[b])).bits for b in bs])
-        offer(bits, keys, p, h, o)
+        offer(np.array([bits(Goal((clauses[a], clauses[b]))) for b in bs]), keys, p, h, o)
         generated += len(bs)
     del state_scene
     distinct = sorted(best.values())
@@ -463,14 +472,15 @@ def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scen
             "probe_moves": len(moves), "seconds": round(time.time() - t0, 1)}
 
 
-def space_info(seed: int = 0, keep: int = 3000) -> dict:
-    """The built space (from the disk cache when the sources have not changed)."""
-    return cached_json(cache_path(f"{seed}-{keep}"), lambda: build_space(seed, keep))
+def space_info(seed: int = 0, keep: int = 3000, prior: FittedPrior | None = None) -> dict:
+    """The built space (from the disk cache when the sources and the prior have not changed)."""
+    tag = f"{seed}-{keep}" if prior is None else f"{seed}-{keep}-{prior.tag}"
+    return cached_json(cache_path(tag), lambda: build_space(seed, keep, prior=prior))
 
 
 @lru_cache(maxsize=4)
-def goal_space(seed: int = 0, keep: int = 3000) -> tuple[Goal, ...]:
-    return tuple(parse_goal(k) for k in space_info(seed, keep)["keys"])
+def goal_space(seed: int = 0, keep: int = 3000, prior: FittedPrior | None = None) -> tuple[Goal, ...]:
+    return tuple(parse_goal(k) for k in space_info(seed, keep, prior)["keys"])
 
 
 __all__ = ["QUANTS", "Compiled", "build_space", "goal_space", "kind_of", "probe_bank", "space_info"]
