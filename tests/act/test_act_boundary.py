@@ -307,3 +307,7 @@ def test_seccomp_program_checks_arguments(machine):
     assert run_filter(prog, arch, prlimit, (0, 7, 0, 0x7FFF0000)) == ALLOW  # reading a limit
     assert run_filter(prog, arch, prlimit, (0, 7, 0x7FFF0000, 0)) == EPERM  # setting one
     assert run_filter(prog, arch, prlimit, (0, 7, 1 << 40, 0)) == EPERM
+    # issue 58, S1: another pid, existing or not, is refused alike (EPERM against ESRCH told them apart)
+    for pid in (1, 4242, 0x3FFFFF, 0xFFFFFFFF):
+        assert run_filter(prog, arch, prlimit, (pid, 7, 0, 0x7FFF0000)) == EPERM, pid
+    assert run_filter(prog, arch, prlimit, (1 << 32, 7, 0, 0x7FFF0000)) == ALLOW  # a pid_t: the kernel reads 32 bits
