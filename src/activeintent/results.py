@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
 
@@ -68,76 +69,164 @@ class Rejected(BaseModel):
     line: int  # 1-based, in the file as it was read
     reason: str
     text: str  # the line as read (undecodable bytes as \x escapes)
+    kind: str = "invalid"  # one of REJECT_KINDS: what the report counts by
 
 
-class Loaded(BaseModel):
-    records: list[dict]
-    rejected: list[Rejected] = Field(default_factory=list)
-    raw: list[bytes] = Field(default_factory=list)  # the accepted lines' bytes, as read
+# Why a line is set aside, as the report counts them.
+REJECT_KINDS = {
+    "undecodable": "not UTF-8 or not JSON",
+    "invalid": "not a valid record (schema)",
+    "plan": "not of this folder's plan (method, intention, trial, settings, seeds)",
+    "inconsistent": "inconsistent with itself (format, curve, provenance)",
+    "duplicate": "more than one record of one episode",
+}
+
+Key = tuple[str, str, int]
 
 
-def _reject_reason(data: bytes, seen: set) -> tuple[dict | None, str | None]:
+@dataclass
+class Candidate:
+    """A valid line of ``results.jsonl``: its line number, record and bytes as read."""
+
+    line: int
+    record: dict
+    raw: bytes
+
+    @property
+    def key(self) -> Key:
+        return (self.record["method"], self.record["intention"], self.record["trial"])
+
+
+@dataclass
+class Loaded:
+    lines: list[Candidate] = field(default_factory=list)  # the valid lines, in file order (duplicates included)
+    rejected: list[Rejected] = field(default_factory=list)
+
+    @property
+    def duplicates(self) -> dict[Key, list[Candidate]]:
+        """Episodes with more than one valid record."""
+        by_key: dict[Key, list[Candidate]] = {}
+        for c in self.lines:
+            by_key.setdefault(c.key, []).append(c)
+        return {k: v for k, v in by_key.items() if len(v) > 1}
+
+    @property
+    def records(self) -> list[dict]:
+        """One per episode: the records of episodes recorded once."""
+        dup = self.duplicates
+        return [c.record for c in self.lines if c.key not in dup]
+
+    @property
+    def raw(self) -> list[bytes]:
+        """The lines kept in the file (duplicates included), as read."""
+        return [c.raw for c in self.lines]
+
+    def set_aside_duplicates(self) -> Loaded:
+        """What a reader that runs no episode does with an episode recorded more than once: it
+        cannot tell the real record from a forged one, so it sets every one of them aside."""
+        dup = self.duplicates
+        for key, cands in dup.items():
+            lines = ", ".join(str(c.line) for c in cands)
+            self.rejected += [Rejected(
+                line=c.line, kind="duplicate", text=c.raw.decode("utf-8", "backslashreplace"),
+                reason=f"one of {len(cands)} records of {key[0]} / {key[1]} / trial {key[2]} (lines {lines}); "
+                       "without re-running the episode none can be trusted") for c in cands]
+        self.lines = [c for c in self.lines if c.key not in dup]
+        self.rejected.sort(key=lambda r: r.line)
+        return self
+
+
+Check = Callable[[dict], "tuple[str, str] | None"]  # a record → (kind, reason) when it does not belong
+
+
+def _reject_reason(data: bytes, check: Check | None) -> tuple[dict | None, str, str]:
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as err:
-        return None, f"not UTF-8 ({err.reason} at byte {err.start})"
+        return None, "undecodable", f"not UTF-8 ({err.reason} at byte {err.start})"
     try:
         rec = json.loads(text, parse_constant=_no_constant)
-    except ValueError as err:
-        return None, f"not JSON ({err})"
+    except (ValueError, RecursionError) as err:
+        return None, "undecodable", f"not JSON ({str(err)[:200]})"
     problem = record_problem(rec)
     if problem:
-        return None, f"not a valid record ({problem})"
-    key = (rec["method"], rec["intention"], rec["trial"])
-    if key in seen:
-        return None, f"duplicate of an earlier record of {key[0]} / {key[1]} / trial {key[2]} (the first is kept)"
-    seen.add(key)
-    return rec, None
+        return None, "invalid", f"not a valid record ({problem})"
+    if check is not None:
+        found = check(rec)
+        if found is not None:
+            return None, found[0], found[1]
+    return rec, "", ""
 
 
 def _no_constant(name: str):
     raise ValueError(f"{name} is not a JSON number")
 
 
-def load_results(path: Path) -> Loaded:
-    """Every line of ``results.jsonl`` checked: undecodable, unparsable, invalid (against the
-    record schema) and duplicate lines (same method, intention, trial as an earlier valid one)
-    are rejected with the reason; the rest are the records. Reads only."""
+def load_results(path: Path, check: Check | None = None) -> Loaded:
+    """Every line of ``results.jsonl`` checked: undecodable, unparsable and invalid (against the
+    record schema) lines, and lines ``check`` refuses (against the folder's plan: see
+    bench/checks.py), are rejected with the reason; an episode with several valid records is
+    in ``duplicates`` (the resume re-runs it, a reader sets them all aside); the rest are the
+    records. Reads only."""
     if not path.exists():
-        return Loaded(records=[])
-    out = Loaded(records=[])
-    seen: set = set()
+        return Loaded()
+    out = Loaded()
     for n, data in enumerate(path.read_bytes().split(b"\n"), start=1):
         if not data.strip():
             continue
-        rec, reason = _reject_reason(data, seen)
+        rec, kind, reason = _reject_reason(data, check)
         if rec is None:
-            out.rejected.append(Rejected(line=n, reason=reason or "",
+            out.rejected.append(Rejected(line=n, kind=kind, reason=reason,
                                          text=data.decode("utf-8", "backslashreplace")))
         else:
-            out.records.append(rec)
-            out.raw.append(data)
+            out.lines.append(Candidate(line=n, record=rec, raw=data))
     return out
 
 
-def read_results(path: Path) -> list[dict]:
-    """The valid records of ``results.jsonl`` (see :func:`load_results`); reads only."""
-    return load_results(path).records
+def read_results(path: Path, check: Check | None = None) -> list[dict]:
+    """The trusted records of ``results.jsonl`` (see :func:`load_results`), an episode recorded
+    more than once left out; reads only."""
+    return load_results(path, check).set_aside_duplicates().records
+
+
+def append_rejected(path: Path, rejected: list[Rejected]) -> Path | None:
+    """Append these lines to ``rejected.jsonl`` beside ``path`` (with their reason), fsynced.
+    Only the folder's writer (who holds its lock) may call this."""
+    if not rejected:
+        return None
+    where = path.with_name("rejected.jsonl")
+    with where.open("ab") as f:
+        for r in rejected:
+            f.write((json.dumps({"file": path.name, **r.model_dump()}) + "\n").encode())
+        _sync(f)
+    return where
 
 
 def set_aside_rejected(path: Path, loaded: Loaded) -> Path | None:
     """Move the rejected lines of ``path`` into ``rejected.jsonl`` beside it (with their reason)
-    and keep only the accepted lines, byte for byte. Only the folder's writer (who holds its
+    and keep only the other lines, byte for byte. Only the folder's writer (who holds its
     lock) may call this. Returns the rejected file, or None when nothing was rejected."""
-    if not loaded.rejected:
-        return None
-    rejected = path.with_name("rejected.jsonl")
-    with rejected.open("ab") as f:
-        for r in loaded.rejected:
-            f.write((json.dumps({"file": path.name, **r.model_dump()}) + "\n").encode())
-        _sync(f)
-    rewrite_results(path, loaded.raw)
-    return rejected
+    where = append_rejected(path, loaded.rejected)
+    if where is not None:
+        rewrite_results(path, loaded.raw)
+    return where
+
+
+def rejected_counts(folder: Path) -> dict[str, int]:
+    """How many lines ``folder/rejected.jsonl`` holds, by kind (REJECT_KINDS; "other" for lines
+    of older code, which did not say)."""
+    path = folder / "rejected.jsonl"
+    counts: dict[str, int] = {}
+    if not path.exists():
+        return counts
+    for line in path.read_bytes().splitlines():
+        try:
+            kind = json.loads(line).get("kind") or "other"
+        except (ValueError, AttributeError, RecursionError):
+            kind = "other"
+        kind = kind if kind in REJECT_KINDS else "other"
+        counts[kind] = counts.get(kind, 0) + 1
+    return counts
 
 
 def rewrite_results(path: Path, lines: list[bytes]) -> None:
@@ -153,31 +242,41 @@ class FolderBusyError(ValueError):
     """Another process writes this results folder."""
 
 
+LOCK_NOTE = ".lock"  # the holder's pid, for the message of a refused second writer; not the lock
+
+
 @contextmanager
 def hold_results_folder(folder: Path) -> Iterator[None]:
     """One writer per results folder: two benches on one ``--out`` would run every episode twice.
-    An advisory lock (flock) on ``folder/.lock``, held while the body runs; the kernel drops it
-    when this process ends, however it ends, so a killed bench never leaves a stale lock."""
+    An advisory lock (flock) on an open descriptor of the folder itself, held while the body
+    runs: removing or replacing any file in it (``rm OUT/.lock``) cannot release it, since the
+    lock belongs to the folder's inode. The kernel drops it when this process ends, however it
+    ends, so a killed bench never leaves a stale lock. ``OUT/.lock`` only names the holder."""
     import fcntl
 
     folder.mkdir(parents=True, exist_ok=True)
-    fd = os.open(folder / ".lock", os.O_RDWR | os.O_CREAT, 0o644)
+    fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
     try:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            raise FolderBusyError(f"{folder} is being written by another process ({_holder(fd)}); "
+            raise FolderBusyError(f"{folder} is being written by another process ({_holder(folder)}); "
                                   "wait for it to finish, or use another --out") from None
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        note = folder / LOCK_NOTE
+        tmp = note.with_name(f"{LOCK_NOTE}.{os.getpid()}.tmp")
+        tmp.write_text(f"{os.getpid()}\n")
+        os.replace(tmp, note)
         yield
     finally:
         os.close(fd)  # releases the lock
 
 
-def _holder(fd: int) -> str:
-    """The process named in a lock file: its pid and, when visible, its command line."""
-    pid = os.pread(fd, 32, 0).decode("ascii", "replace").strip()
+def _holder(folder: Path) -> str:
+    """The process named in the folder's lock note: its pid and, when visible, its command line."""
+    try:
+        pid = (folder / LOCK_NOTE).read_text(encoding="ascii", errors="replace")[:32].strip()
+    except OSError:
+        pid = ""
     if not pid.isdigit():
         return "pid unknown"
     try:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import re
 import socket
+import unicodedata
 from pathlib import Path
 
 import pytest
@@ -50,12 +51,21 @@ def assert_no_datagram(srv: socket.socket) -> None:
     raise AssertionError(f"the sandbox sent a datagram {data[:40]!r} from {addr}")
 
 
+def unclean(c: str) -> bool:
+    """A character cleaned text must not hold, by Unicode's categories (not the cleaner's table):
+    controls but tab and newline, format characters (bidi, zero-width, soft hyphen, tags,
+    interlinear annotation...), line and paragraph separators, surrogates, the tag block."""
+    return ((unicodedata.category(c) in ("Cc", "Cf", "Zl", "Zp", "Cs") and c not in "\t\n")
+            or 0xE0000 <= ord(c) <= 0xE007F)
+
+
 def assert_clean_text(text: str | None, limit: int = 4000) -> None:
     """Valid UTF-8, no control or formatting characters but newline and tab, no addresses."""
     if text is None:
         return
     text.encode("utf-8")  # raises on lone surrogates
     assert not _UNCLEAN.search(text), repr(text[:200])
+    assert not any(unclean(c) for c in text), repr(text[:200])
     assert not _ADDRESS.search(text), repr(text[:200])
     assert len(text) <= limit
 

@@ -322,6 +322,10 @@ CORPUS: list[Hostile] = [
     _h("ansi-escapes", "say('\\x1b[2J\\x1b[31mred\\x1b]0;owned\\x07\\x1b[0m')\nsay(chr(0x9b) + '31m')", HARMLESS),
     _h("lone-surrogate", "say('\\ud800')\nsay(chr(0xdc80) + 'x')", HARMLESS),
     _h("bidi-override", "say('abc\\u202edcba\\u2066')", HARMLESS),
+    # issue 58, S2: format characters the cleaner used to keep (Arabic letter mark, soft hyphen,
+    # interlinear annotation, tag characters spelling a hidden "IGNORE")
+    _h("invisible-format", "say('a\\u061cb\\u00adc\\ufff9d\\ufffae\\ufffbf')\n"
+       "say('ok' + ''.join(chr(0xE0000 + ord(c)) for c in 'IGNORE') + chr(0xE007F) + chr(0xE0000))", HARMLESS),
     _h("carriage-return", "say('ok\\rHACKED\\x08\\x00')", HARMLESS),
     _h("address-leak", "say(say)\nsay(repr(np.linalg))\nprint(get_obj_pos)", HARMLESS),
     _h("error-escapes", "raise ValueError('\\x1b[31m' + '\\ud800' + 'x' * 10000)", CONTAINED),

@@ -104,6 +104,22 @@ def test_clean_text(text, clean):
     assert clean_text(text) == clean
 
 
+def test_the_cleaners_table_is_unicodes_format_and_control_characters():
+    """S2: the cleaner kept U+061C, U+00AD, U+FFF9–FFFB and the tag characters U+E0000–E007F.
+    Its one table must now remove exactly what Unicode calls a control, format, line or
+    paragraph separator character (and the tag block), every code point checked."""
+    from act_helpers import unclean
+
+    from activeintent.act.sanitize import REMOVED
+
+    table = {cp for a, b in REMOVED for cp in range(a, b + 1)}
+    by_unicode = {cp for cp in range(0x110000) if not 0xD800 <= cp <= 0xDFFF and unclean(chr(cp))}
+    assert table == by_unicode, (sorted(table - by_unicode)[:10], sorted(by_unicode - table)[:10])
+    assert clean_text("a\u061cb\u00adc\ufff9d\U000e0041\U000e0000e") == "abcde"
+    for cp in sorted(by_unicode - {0x1B}):  # ESC takes the character after it along (an escape sequence)
+        assert clean_text(f"x{chr(cp)}y") == "xy", hex(cp)
+
+
 def test_clean_text_caps_and_never_raises():
     class Unprintable:
         def __str__(self) -> str:
@@ -307,3 +323,7 @@ def test_seccomp_program_checks_arguments(machine):
     assert run_filter(prog, arch, prlimit, (0, 7, 0, 0x7FFF0000)) == ALLOW  # reading a limit
     assert run_filter(prog, arch, prlimit, (0, 7, 0x7FFF0000, 0)) == EPERM  # setting one
     assert run_filter(prog, arch, prlimit, (0, 7, 1 << 40, 0)) == EPERM
+    # issue 58, S1: another pid, existing or not, is refused alike (EPERM against ESRCH told them apart)
+    for pid in (1, 4242, 0x3FFFFF, 0xFFFFFFFF):
+        assert run_filter(prog, arch, prlimit, (pid, 7, 0, 0x7FFF0000)) == EPERM, pid
+    assert run_filter(prog, arch, prlimit, (1 << 32, 7, 0, 0x7FFF0000)) == ALLOW  # a pid_t: the kernel reads 32 bits

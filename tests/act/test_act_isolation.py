@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 from act_helpers import SECRET_VALUE, TEST_LIMITS, descendants, require_namespaces
 
-from activeintent.act import isolation
+from activeintent.act import isolation, seccomp
 from activeintent.act.cap import CapExecutor
 from activeintent.act.executors import make_executor
 from activeintent.act.isolation import (
@@ -108,6 +108,25 @@ def test_seccomp_refuses_system_calls(unguarded_sandbox, state):
             "exec": attempt(lambda: os.execv("/bin/true", ["true"])),
         }"""), state)
     assert facts == dict.fromkeys(facts, "EPERM")
+
+
+def test_prlimit64_names_no_other_process(seccomp_only_sandbox, state):
+    """S1 (--unsafe-no-isolation, where the program sees host pids): prlimit64 on another pid
+    answered EPERM for a process that exists and ESRCH for one that does not, a map of the
+    host's pids. Now only pid 0 (itself) passes the filter. Run as root and, in CI, as an
+    unprivileged user (tests/act/run_unprivileged.py)."""
+    nr = seccomp.allowed_syscalls()["prlimit64"]
+    facts = _facts(seccomp_only_sandbox, textwrap.dedent(f"""
+        import ctypes, errno, json, os
+        libc = ctypes.CDLL(None, use_errno=True)
+        old = ctypes.create_string_buffer(16)
+        def probe(pid):
+            if libc.syscall({nr}, ctypes.c_long(pid), 7, None, old) == -1:
+                return errno.errorcode.get(ctypes.get_errno(), "?")
+            return "allowed"
+        facts = {{"self": probe(0), "parent": probe(os.getppid()), "init": probe(1),
+                  "absent": probe(4194303)}}"""), state)
+    assert facts == {"self": "allowed", "parent": "EPERM", "init": "EPERM", "absent": "EPERM"}, facts
 
 
 def test_resource_limits_in_the_child(unguarded_sandbox, state):

@@ -57,13 +57,13 @@ def test_forged_invalid_and_duplicate_records_are_never_trusted(tmp_path):
     (line,) = results.read_text().splitlines()
     real = json.loads(line)
     forged = {"method": "zero-signal", "intention": "color-match", "trial": 1, "success": 1.0}  # the three keys only
-    duplicate = {**real, "success": 1.0 - (real["success"] or 0)}  # valid, but trial 0 is already there
+    duplicate = {**real, "success": 1.0 - (real["success"] or 0)}  # trial 0 is already there; contradicts its curve
     wrong_type = {**real, "trial": 2, "wall_s": "slow"}  # crashed the report before
     with results.open("a") as f:
         f.write("".join(json.dumps(r) + "\n" for r in (forged, duplicate, wrong_type)))
     res = bench(tmp_path, 3)
     text = " ".join(res.output.split())
-    assert "3 line(s) of results.jsonl not trusted" in text and "duplicate" in text
+    assert "3 line(s) of results.jsonl not trusted" in text and "not its own curve's last value" in text
     records = {r["trial"]: r for r in load_results(results).records}
     assert sorted(records) == [0, 1, 2] and len(keys(results)) == 3
     assert records[0] == real  # the first valid record is kept, the forged duplicate is not
@@ -71,7 +71,7 @@ def test_forged_invalid_and_duplicate_records_are_never_trusted(tmp_path):
     reasons = [r["reason"] for r in rejected(tmp_path)]
     assert len(reasons) == 3
     assert "not a valid record" in reasons[0] and "seed" in reasons[0]
-    assert "duplicate" in reasons[1]
+    assert "curve" in reasons[1]
     assert "wall_s" in reasons[2]
     assert "| zero-signal" in (tmp_path / "report.md").read_text()
 

@@ -10,9 +10,11 @@ from pathlib import Path
 
 import pytest
 
+from activeintent.bench.checks import Plan
 from activeintent.bench.verify import NOT_VERIFIED, StaleFolder, differences, sample_records, verify
+from activeintent.bench.work import read_bench_config
 from activeintent.protocol import FORMAT_VERSION
-from activeintent.results import read_results
+from activeintent.results import load_results, read_results
 
 RESULTS = Path(__file__).resolve().parents[2] / "docs" / "results"
 PAPER = RESULTS / "paper"
@@ -46,11 +48,14 @@ def test_every_results_folder_is_verified_or_says_why_not():
             assert not (folder / "results.jsonl").exists()
             continue
         assert (folder / "bench.json").is_file(), folder
+        plan = Plan(read_bench_config(folder / "bench.json"))
+        loaded = load_results(folder / "results.jsonl", plan).set_aside_duplicates()
+        assert loaded.rejected == [], folder.name  # every record belongs to its folder (bench/checks.py)
         if (folder / NOT_VERIFIED).is_file():
             with pytest.raises(StaleFolder):
                 verify(folder, sample=1)
             continue
-        records = read_results(folder / "results.jsonl")
+        records = loaded.records
         assert records and all(r["format"] == FORMAT_VERSION for r in records), folder.name
         made = {(r["provenance"]["commit"], r["provenance"]["dirty"]) for r in records}
         assert all(commit and dirty is False for commit, dirty in made), f"{folder.name}: made by {made}"
@@ -116,7 +121,8 @@ def test_a_changed_line_is_reported(tmp_path):
     shutil.copy(PAPER / "bench.json", folder / "bench.json")
     lines = [json.loads(x) for x in (PAPER / "results.jsonl").read_text().splitlines()]
     first = min((r for r in lines if r["method"] == "zero-signal"), key=lambda r: (r["trial"], r["intention"]))
-    first["success_at"] = [1.0] * len(first["success_at"])  # a flattering edit
+    first["success_at"] = [1.0] * len(first["success_at"])  # a flattering edit, consistent with itself
+    first["success"] = 1.0
     (folder / "results.jsonl").write_text(json.dumps(first) + "\n")
     (diff,) = verify(folder, sample=1)
     assert diff["method"] == "zero-signal" and "success_at" in diff["changed"]

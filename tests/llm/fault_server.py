@@ -79,10 +79,26 @@ class Dropped:
         self.content = content
 
 
+class Gzip:
+    """A 200 whose body is ``body`` gzip-compressed (``Content-Encoding: gzip``), whatever the
+    client asked for: a bomb when ``body`` is large and repetitive."""
+
+    def __init__(self, compressed: bytes) -> None:
+        self.compressed = compressed
+
+
+class Redirect:
+    """A redirect (307 by default) to ``location``."""
+
+    def __init__(self, location: str, code: int = 307) -> None:
+        self.location, self.code = location, code
+
+
 class FaultServer:
     def __init__(self) -> None:
         self.script: deque[Any] = deque()
         self.requests: list[dict[str, Any]] = []
+        self.headers: list[dict[str, str]] = []  # each POST's request headers
         self.default: Any = Ok("default answer")
         self.bytes_sent = 0  # by Huge
         self._release = threading.Event()
@@ -101,6 +117,7 @@ class FaultServer:
                 length = int(self.headers.get("Content-Length", 0))
                 body = json.loads(self.rfile.read(length) or b"{}")
                 server.requests.append(body)
+                server.headers.append({k.lower(): v for k, v in self.headers.items()})
                 action = server.script.popleft() if server.script else server.default
                 if isinstance(action, Ok):
                     payload = json.dumps(completion_body(action.content, model=body.get("model", "")))
@@ -136,6 +153,10 @@ class FaultServer:
                             server.bytes_sent += len(chunk)
                     except OSError:  # the client stopped reading and closed
                         return
+                elif isinstance(action, Gzip):
+                    self._send(200, action.compressed, {"Content-Encoding": "gzip"})
+                elif isinstance(action, Redirect):
+                    self._send(action.code, b"", {"Location": action.location})
                 elif isinstance(action, Hang):
                     server._release.wait()
                     self.close_connection = True

@@ -137,3 +137,35 @@ def test_several_processes_write_one_cache(tmp_path):
     cache = ResponseCache(path, "replay")
     assert len(cache) == 120
     assert cache.get("2-39").text == "answer 2 39"
+
+
+def test_answers_of_one_server_are_not_replayed_for_another(tmp_path, monkeypatch):
+    """C1: keys named no server, so a cache recorded from one server answered for any other
+    serving a model of the same name (a local `qwen` and a hosted `qwen` mixed silently)."""
+    monkeypatch.delenv("ACTIVEINTENT_CACHE_LEGACY_KEYS", raising=False)
+    user = [Message(role="user", content="Which bowl?")]
+    path = tmp_path / "cache.sqlite"
+    with FaultServer() as local, FaultServer() as hosted:
+        local.default, hosted.default = Ok("local answer"), Ok("hosted answer")
+
+        def qwen(server, **kw):
+            return BackendModel(OpenAIBackend("qwen", base_url=server.base_url, api_key="k"),
+                                cache=ResponseCache(path, "record", **kw))
+
+        assert qwen(local).chat(user) == "local answer"
+        assert qwen(hosted).chat(user) == "hosted answer"  # not the local server's, from the cache
+        assert len(hosted.requests) == 1
+        assert qwen(local).chat(user) == "local answer" and len(local.requests) == 1  # still cached per server
+
+        # An entry recorded before keys named servers is read only when asked for explicitly.
+        old = ResponseCache(path, "record")
+        request = ChatRequest(messages=user, seed=0)
+        old.put(old.key("openai", "qwen", request), Completion(text="old answer"), backend="openai", model="qwen")
+        with FaultServer() as third:
+            third.default = Ok("third answer")
+            assert qwen(third).chat(user) == "third answer"
+            assert qwen(third, legacy_keys=False).chat(user) == "third answer"
+        with FaultServer() as fourth:
+            assert qwen(fourth, legacy_keys=True).chat(user) == "old answer" and fourth.requests == []
+            monkeypatch.setenv("ACTIVEINTENT_CACHE_LEGACY_KEYS", "1")
+            assert qwen(fourth).chat(user) == "old answer" and fourth.requests == []

@@ -7,10 +7,21 @@ import json
 import time
 
 import pytest
-from fault_server import Drip, FaultServer, Hang, Huge, Ok, Raw, Status, completion_body
+from fault_server import (
+    Drip,
+    FaultServer,
+    Gzip,
+    Hang,
+    Huge,
+    Ok,
+    Raw,
+    Redirect,
+    Status,
+    completion_body,
+)
 
 from activeintent.llm.backend import BackendModel
-from activeintent.llm.base import Message, ModelError, TransientModelError
+from activeintent.llm.base import Message, ModelError, ModelRedirectError, TransientModelError
 from activeintent.llm.openai_compat import CallLimits, OpenAIBackend
 from activeintent.llm.retry import RetryPolicy
 
@@ -118,3 +129,66 @@ def test_limits_come_from_the_environment(monkeypatch):
     monkeypatch.setenv("ACTIVEINTENT_MODEL_DEADLINE_S", "soon")
     with pytest.raises(ValueError, match="ACTIVEINTENT_MODEL_DEADLINE_S"):
         CallLimits.from_env()
+
+
+def _gzip_bomb(inflated: int) -> bytes:
+    """A valid gzip stream of ``inflated`` bytes of spaces (about a thousandth of that on the wire)."""
+    import zlib
+
+    z = zlib.compressobj(9, zlib.DEFLATED, 31)
+    chunk = b" " * 2**20
+    return b"".join(z.compress(chunk) for _ in range(inflated // len(chunk))) + z.flush()
+
+
+def test_a_gzip_bomb_is_refused_unread(server):
+    """L1: the cap counted bytes on the wire, so a 128 KiB gzip body inflated to 128 MiB in the
+    client before the size check (a 1 MB body to 1 GiB). Now the client asks for no compression
+    and refuses a compressed body without decompressing it, not retried."""
+    import tracemalloc
+
+    server.default = Gzip(_gzip_bomb(128 * 2**20))
+    client = model(server, max_bytes=2**20)
+    tracemalloc.start()
+    try:
+        with pytest.raises(ModelError, match="compressed with 'gzip'"):
+            client.chat(USER)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 16 * 2**20, f"{peak / 2**20:.0f} MiB allocated"
+    assert len(server.requests) == 1
+    assert server.headers[0]["accept-encoding"] == "identity"
+
+
+def test_a_redirect_is_not_followed_and_says_where_it_pointed(server):
+    """L3: a 307 to another server used to be followed, re-sending the whole prompt there (and the
+    run ended exit 0 on the other server's answers)."""
+    with FaultServer() as other:
+        other.default = Ok("the other server's answer")
+        server.default = Redirect(other.base_url + "/chat/completions")
+        with pytest.raises(ModelRedirectError, match="redirect to .*127.0.0.1") as info:
+            model(server).chat(USER)
+        assert info.value.location == other.base_url + "/chat/completions"
+        assert other.requests == [] and len(server.requests) == 1
+
+
+def test_json_nesting_is_bounded_without_recursion():
+    """L2 below the client: the depth scan ignores brackets inside strings and never recurses."""
+    from activeintent.llm.backend import (
+        MAX_JSON_DEPTH,
+        TooDeep,
+        json_depth,
+        loads_bounded,
+        parse_structured,
+    )
+    from activeintent.llm.openai_compat import parse_answer
+
+    assert json_depth('{"a": [[1]], "b": "[[[[\\"[["}') == 3
+    assert loads_bounded("[" * MAX_JSON_DEPTH + "]" * MAX_JSON_DEPTH) is not None
+    with pytest.raises(TooDeep):
+        loads_bounded("[" * (MAX_JSON_DEPTH + 1) + "]" * (MAX_JSON_DEPTH + 1))
+    deep = "[" * 200_000 + "]" * 200_000
+    with pytest.raises(ValueError, match="nest 200001 deep"):
+        parse_answer(('{"choices": ' + deep + "}").encode())
+    with pytest.raises(TooDeep):
+        parse_structured('{"a": ' + deep + "}", type("S", (), {}))

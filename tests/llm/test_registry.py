@@ -97,5 +97,6 @@ def test_replay_needs_no_api_key(tmp_path, monkeypatch):
         server.default = Ok("recorded")
         recorder = load_model("openai:gpt-x", base_url=server.base_url, cache_path=path)
         assert recorder.chat([Message(role="user", content="q")]) == "recorded"
-    offline = load_model("openai:gpt-x", cache_path=path, cache_mode="replay")
+    # The server is gone and there is no key: the cache answers (its keys name the server's URL).
+    offline = load_model("openai:gpt-x", base_url=server.base_url, cache_path=path, cache_mode="replay")
     assert offline.chat([Message(role="user", content="q")]) == "recorded"

@@ -243,3 +243,27 @@ def test_idle_connections_from_one_address_neither_lock_others_out_nor_flood_the
     assert len(text) < 20_000, f"the log grew to {len(text)} characters: {text[:2000]}"
     assert "Traceback" not in text, text[:3000]
     assert text.count("Too many open files") <= 3, text[:3000]
+
+
+# -- issue 58, W1: the request-head limit counts the whole head, however it arrives -------------------
+@pytest.mark.parametrize("pieces", [1, 4, 60])
+def test_a_head_over_the_limit_is_refused_in_one_send_or_in_pieces(live_server, pieces):
+    """Before, the 16 KiB limit held only when the head arrived in pieces: a 60,000-byte header
+    sent in one send got 200."""
+    srv = live_server("bayes-stop", rounds=1)
+    host, port = host_port(srv.url)
+    head = (f"GET / HTTP/1.1\r\nHost: {host}:{port}\r\nX-Pad: {'a' * 60_000}\r\n\r\n").encode()
+    step = -(-len(head) // pieces)
+    with socket.create_connection((host, port), timeout=10) as sock:
+        try:
+            for i in range(0, len(head), step):
+                sock.sendall(head[i:i + step])
+                if pieces > 1:
+                    time.sleep(0.005)
+        except OSError:  # the server may close while the rest is still being sent
+            pass
+        status, headers, text = read_response(sock, "GET")
+    assert status == 431, (status, text[:200])
+    assert error_code(text) == "head_too_large" and headers["connection"] == "close"
+    ok = httpx.get(srv.url + "/", headers={"X-Pad": "a" * 8000}, timeout=10)  # a head under the limit
+    assert ok.status_code == 200

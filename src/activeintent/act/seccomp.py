@@ -22,8 +22,9 @@ What passes, and why the program needs it:
   ``rt_sigprocmask``, ``rt_sigreturn``, ``restart_syscall``;
 - reading (never setting) clocks, its own ids and its resource limits: ``clock_gettime``,
   ``clock_getres``, ``gettimeofday``, ``time``, ``getpid``, ``getppid``, ``gettid``,
-  ``getuid``, ``geteuid``, ``getgid``, ``getegid``, ``getrlimit`` and ``prlimit64`` with no new
-  limit (libc's abort path reads the pid; a clock without a vDSO fast path is a real call).
+  ``getuid``, ``geteuid``, ``getgid``, ``getegid``, ``getrlimit`` and ``prlimit64`` on pid 0
+  (itself) with no new limit (libc's abort path reads the pid; a clock without a vDSO fast path
+  is a real call).
 
 That list was checked with ``strace -f`` on the worker running the test suite's programs: after
 the filter, a program process made only ``brk``, ``mmap``, ``munmap``, ``write`` and
@@ -126,9 +127,13 @@ def build_filter(machine: str | None = None) -> bytes | None:
     # fcntl: only the commands in FCNTL_ALLOWED.
     fcntl_check = _allow_if_arg_in(1, sorted(FCNTL_ALLOWED.values()))
     prog += [_insn(_JEQ_K, 0, len(fcntl_check), table["fcntl"]), *fcntl_check]
-    # prlimit64 may read limits (new_limit, the third argument, NULL) but never set them.
+    # prlimit64 may read its own limits (pid, the first argument, 0: a pid_t, so its low 32 bits;
+    # new_limit, the third, NULL) but never set any, nor name another process: EPERM for every
+    # other pid, so EPERM against ESRCH cannot tell which host pids exist.
     prog += [
-        _insn(_JEQ_K, 0, 6, table["prlimit64"]),
+        _insn(_JEQ_K, 0, 8, table["prlimit64"]),
+        _insn(_LD_W_ABS, 0, 0, _ARG_LOW[0]),
+        _insn(_JEQ_K, 0, 5, 0),
         _insn(_LD_W_ABS, 0, 0, _ARG_LOW[2]),
         _insn(_JEQ_K, 0, 3, 0),
         _insn(_LD_W_ABS, 0, 0, _ARG_LOW[2] + 4),

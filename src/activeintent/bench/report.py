@@ -297,6 +297,7 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
     if made:
         lines += [f"Made by commit {', '.join(made)} on {'; '.join(cpus)} (provenance of every episode: "
                   "`provenance` in results.jsonl).", ""]
+    lines += set_aside_lines(out)
     if settings.get("env") == "symbolic":
         lines += ["**Env: symbolic** — outcomes from the symbolic world model, not physics.", ""]
     suites: dict[str, list[str]] = defaultdict(list)
@@ -350,6 +351,18 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
     path = out / "report.md"
     path.write_text("\n".join(lines))
     return path
+
+
+def set_aside_lines(out: Path) -> list[str]:
+    """How many lines of results.jsonl were set aside into rejected.jsonl, and why (none: nothing)."""
+    from activeintent.results import REJECT_KINDS, rejected_counts
+
+    counts = rejected_counts(out)
+    if not counts:
+        return []
+    why = "; ".join(f"{n} {REJECT_KINDS.get(kind, 'set aside by older code')}" for kind, n in sorted(counts.items()))
+    return [f"**Set aside:** {sum(counts.values())} line(s) of results.jsonl were not trusted and are not counted "
+            f"(`rejected.jsonl`, each with its reason): {why}.", ""]
 
 
 def _oracle_row(oracle: dict[str, dict] | None, suite: str, names: list[str], width: int) -> list[str]:

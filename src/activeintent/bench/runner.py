@@ -24,17 +24,23 @@ from concurrent.futures.process import BrokenProcessPool
 from multiprocessing import get_context
 from pathlib import Path
 
+from activeintent.bench.checks import Plan
 from activeintent.bench.work import (
     BenchConfig,
     WorkItem,
     bench_json,
     protocol_fields,
+    read_bench_config,
     run_item,
     write_bench_config,
 )
 from activeintent.learners.registry import PAPER_METHODS
+from activeintent.protocol import FORMAT_VERSION
+from activeintent.records import dumps
 from activeintent.results import (
+    Candidate,
     Rejected,
+    append_rejected,
     append_result,
     hold_results_folder,
     load_results,
@@ -45,35 +51,88 @@ from activeintent.results import (
 
 def run_bench(options: BenchConfig, out: Path, on_done: Callable[[dict, int, int], None] | None = None,
               on_rejected: Callable[[list[Rejected], Path], None] | None = None) -> list[dict]:
-    """Run what is missing from ``out/results.jsonl``; returns all records. ``on_rejected`` hears
-    of the lines set aside into ``rejected.jsonl`` (never counted, never fatal)."""
+    """Run what is missing from ``out/results.jsonl``; returns all records. Every line is checked
+    against the folder's plan (bench/checks.py); ``on_rejected`` hears of the lines set aside
+    into ``rejected.jsonl`` (never counted, never fatal). An episode recorded more than once is
+    run again once: the record equal to the re-run is kept, the others are set aside (none
+    equal: all of them, and the re-run is the record)."""
     with hold_results_folder(out):
         results_path = out / "results.jsonl"
         _check_same_settings(options, out / "bench.json")
-        write_bench_config(options, out / "bench.json")
-        loaded = load_results(results_path)
+        plan_options = _planned(options, out / "bench.json")
+        write_bench_config(plan_options, out / "bench.json")
+        loaded = load_results(results_path, Plan(plan_options))
+        if options.retry_errors:
+            loaded.lines = [c for c in loaded.lines if not c.record.get("error")]
+        duplicates = loaded.duplicates
         rejected_file = set_aside_rejected(results_path, loaded)
+        if options.retry_errors and rejected_file is None:
+            rewrite_results(results_path, loaded.raw)
         if rejected_file is not None and on_rejected:
             on_rejected(loaded.rejected, rejected_file)
         records = loaded.records
-        if options.retry_errors:
-            kept = [(r, raw) for r, raw in zip(loaded.records, loaded.raw, strict=True) if not r.get("error")]
-            if len(kept) != len(records):
-                rewrite_results(results_path, [raw for _, raw in kept])
-            records = [r for r, _ in kept]
         done = {(r["method"], r["intention"], r["trial"]) for r in records}
+        planned = [it.key for it in options.items()]
         todo = [it for it in options.items() if it.key not in done]
-        total = len(options.items())
-        finished = total - len(todo)
+        todo += [WorkItem(method=k[0], intention=k[1], trial=k[2]) for k in duplicates if k not in planned]
+        total = len(planned)
+        finished = total - sum(1 for it in todo if it.key in set(planned))
         if on_done:
             on_done({}, finished, total)
         for record in _execute(todo, options, out):
-            append_result(results_path, record)
+            key = (record["method"], record["intention"], record["trial"])
+            if key in duplicates:
+                record, aside = _settle_duplicate(results_path, record, duplicates.pop(key))
+                if on_rejected:
+                    on_rejected(aside, results_path.with_name("rejected.jsonl"))
+            else:
+                append_result(results_path, record)
             records.append(record)
             finished += 1
             if on_done:
                 on_done(record, finished, total)
         return records
+
+
+def _settle_duplicate(path: Path, again: dict, cands: list[Candidate]) -> tuple[dict, list[Rejected]]:
+    """An episode with several records in ``path``, run again: the record equal to the re-run
+    (by bench-verify's comparison) stays, the others are set aside; none equal, all are, and
+    the re-run's record takes their place. Set aside first, then the file rewritten at once: a
+    kill in between leaves the duplicates in place, to be settled by the next resume."""
+    from activeintent.bench.verify import differences
+
+    plain = json.loads(dumps(again))  # as it would be read back
+    winner = next((c for c in cands if not again.get("error") and not differences(c.record, plain)), None)
+    losers = [c for c in cands if c is not winner]
+    aside = [Rejected(line=c.line, kind="duplicate", text=c.raw.decode("utf-8", "backslashreplace"),
+                      reason=(f"one of {len(cands)} records of {c.key[0]} / {c.key[1]} / trial {c.key[2]}: "
+                              + ("another one equals the episode run again" if winner
+                                 else "none equals the episode run again, whose record replaces them")))
+             for c in losers]
+    append_rejected(path, aside)
+    lines = [line for line in path.read_bytes().split(b"\n") if line.strip()]
+    for c in losers:
+        lines.remove(c.raw)  # identical lines are interchangeable: any one of them goes
+    if winner is None:
+        lines.append(dumps({"format": FORMAT_VERSION, **again}).encode())
+    rewrite_results(path, lines)
+    return (winner.record if winner else again), aside
+
+
+def _planned(options: BenchConfig, path: Path) -> BenchConfig:
+    """The folder's plan after this resume: methods, intentions and trials may grow on resume,
+    and a resume that names fewer keeps those of the folder (its records stay planned)."""
+    if not path.exists():
+        return options
+    before = read_bench_config(path)
+
+    def union(a: list[str], b: list[str]) -> list[str]:
+        return a + [x for x in b if x not in a]
+
+    return options.model_copy(update={"methods": union(options.methods, before.methods),
+                                      "intentions": union(options.intentions, before.intentions),
+                                      "intention_files": union(options.intention_files, before.intention_files),
+                                      "trials": max(options.trials, before.trials)})
 
 
 _SETTINGS = ("seed", "run")  # methods, intentions and trials may grow on resume; these may not change

@@ -1,6 +1,8 @@
 """`activeintent bench-verify DIR`: re-run a sample of a results folder's episodes from its
 recorded settings (``bench.json``) and compare them with the recorded lines, so published
-numbers cannot drift from the code silently.
+numbers cannot drift from the code silently. Before that, every line is checked against the
+folder's plan and itself (bench/checks.py, cheap): a line that does not belong, or an episode
+recorded twice, fails the folder.
 
 Whole records are compared, except what describes the run rather than the episode: wall time
 and its split, provenance (commit, versions, CPU, date) and tracebacks. A folder written under
@@ -80,8 +82,22 @@ def sample_records(records: list[dict], sample: int) -> list[dict]:
     return out
 
 
+def untrusted(folder: Path) -> list:
+    """Every line of the folder's results.jsonl that its plan (bench.json) or its own fields do
+    not support (bench/checks.py), and every episode recorded more than once: cheap, no episode
+    is run. Empty when every record belongs to the folder."""
+    from activeintent.bench.checks import Plan
+    from activeintent.bench.work import read_bench_config
+    from activeintent.results import load_results
+
+    plan = Plan(read_bench_config(folder / "bench.json"))
+    return load_results(folder / "results.jsonl", plan).set_aside_duplicates().rejected
+
+
 def verify(folder: Path, sample: int, methods: list[str] | None = None) -> list[dict]:
-    """Differences between recorded and re-run episodes (empty when they agree)."""
+    """Differences between recorded and re-run episodes (empty when they agree). Only records
+    that pass the folder's checks (:func:`untrusted`) are sampled."""
+    from activeintent.bench.checks import Plan
     from activeintent.bench.work import WorkItem, read_bench_config, run_item
     from activeintent.results import read_results
 
@@ -89,7 +105,7 @@ def verify(folder: Path, sample: int, methods: list[str] | None = None) -> list[
     if note.is_file():
         raise StaleFolder(f"{folder} cannot be verified: {note.read_text().strip().splitlines()[0].lstrip('# ')}")
     options = read_bench_config(folder / "bench.json")
-    records = [r for r in read_results(folder / "results.jsonl") if not r.get("error")]
+    records = [r for r in read_results(folder / "results.jsonl", Plan(options)) if not r.get("error")]
     old = sorted({r.get("format") for r in records if r.get("format") != FORMAT_VERSION}, key=str)
     if old:
         raise StaleFolder(f"{folder} holds records of format {', '.join(map(str, old))}; this code writes format "
@@ -144,8 +160,9 @@ def bench_verify(
     every: Annotated[bool, typer.Option("--all", help="Every committed folder (docs/results/*, experiments/*/results/*), "
                                         "one episode of every method each (run from the repository's root)")] = False,
 ) -> None:
-    """Re-run a sample of a results folder and compare; exit 1 when the code no longer gives
-    the recorded results, 2 when the folder cannot be verified."""
+    """Check every record of a results folder against its bench.json and itself, re-run a
+    sample and compare; exit 1 when a record does not belong to the folder or the code no
+    longer gives the recorded results, 2 when the folder cannot be verified."""
     if every:
         folders = committed_folders(Path.cwd())
         if not folders:
@@ -155,8 +172,11 @@ def bench_verify(
         for i, f in enumerate(folders, 1):
             typer.echo(f"[{i}/{len(folders)}] {f}")
             n = len(methods_of(f))
+            foreign = untrusted(f)
+            for r in foreign:
+                typer.echo(f"  results.jsonl line {r.line} not trusted ({r.kind}): {r.reason}")
             try:
-                ok = _report(f, verify(f, n), n)
+                ok = _report(f, verify(f, n), n) and not foreign
             except StaleFolder as err:
                 typer.echo(f"  cannot be verified: {err}")
                 stale.append(f)
@@ -172,6 +192,12 @@ def bench_verify(
     if not (folder / "bench.json").is_file():
         typer.echo(f"error: {folder} has no bench.json (not a results folder written by `bench`)", err=True)
         raise typer.Exit(2)
+    bad = untrusted(folder)
+    for r in bad:
+        typer.echo(f"results.jsonl line {r.line} not trusted ({r.kind}): {r.reason}")
+    if bad:
+        typer.echo(f"{len(bad)} line(s) of {folder}/results.jsonl do not belong to the folder", err=True)
+        raise typer.Exit(1)
     try:
         diffs = verify(folder, sample, [m for m in methods.split(",") if m] or None)
     except StaleFolder as err:
@@ -179,3 +205,4 @@ def bench_verify(
         raise typer.Exit(2) from None
     if not _report(folder, diffs, sample):
         raise typer.Exit(1)
+    typer.echo(f"every record of {folder}/results.jsonl is consistent with its bench.json")

@@ -15,6 +15,7 @@ from pydantic import BaseModel, ValidationError
 
 from activeintent.llm.accounting import CallRecord, Usage
 from activeintent.llm.base import (
+    AnswerTooDeepError,
     CacheMissError,
     ChatModel,
     ImagesNotSupportedError,
@@ -61,6 +62,7 @@ class Backend(ABC):
 
     kind: str = "backend"  # "openai", "llama.cpp", "scripted"
     model_name: str = "model"
+    server: str | None = None  # a model server's base URL (part of the cache key); None in-process
     accepts_images: bool = False
     seed: int = 0
 
@@ -108,11 +110,45 @@ def extract_json(text: str) -> str:
     return text[start : end + 1]
 
 
+MAX_JSON_DEPTH = 64  # nesting of arrays and objects in a model's JSON; answers need a handful
+# A string, its closing quote optional: an unterminated one runs to the end, so every character
+# is consumed once (linear, whatever the quotes and backslashes).
+_JSON_STRING = re.compile(r'"(?:[^"\\]|\\.)*"?', re.DOTALL)
+
+
+def json_depth(text: str) -> int:
+    """How deeply the arrays and objects of a JSON text nest (brackets inside strings do not
+    count), without parsing it: linear, no recursion, so any size and depth is safe to ask."""
+    import numpy as np
+
+    outside = _JSON_STRING.sub("", text).encode("utf-8", "replace")
+    b = np.frombuffer(outside, dtype=np.uint8)
+    step = ((b == ord("[")) | (b == ord("{"))).astype(np.int64) - ((b == ord("]")) | (b == ord("}")))
+    return int(np.cumsum(step).max(initial=0))
+
+
+class TooDeep(ValueError):
+    """JSON nested deeper than allowed."""
+
+
+def loads_bounded(text: str, *, max_depth: int = MAX_JSON_DEPTH, **kwargs: Any) -> Any:
+    """``json.loads`` for untrusted text: :class:`TooDeep` (a ValueError; not a RecursionError,
+    nor a deep object for every later recursive walk) when arrays and objects nest deeper than
+    ``max_depth``."""
+    depth = json_depth(text)
+    if depth > max_depth:
+        raise TooDeep(f"its arrays and objects nest {depth} deep (at most {max_depth})")
+    try:
+        return json.loads(text, **kwargs)
+    except RecursionError:  # a second line: the scan above should have refused it
+        raise TooDeep(f"its arrays and objects nest too deep (at most {max_depth})") from None
+
+
 def parse_structured(text: str, schema: type[T]) -> T:
     """Validate ``text`` against ``schema``; a ValueError says why it failed, in words."""
     candidate = extract_json(text)
     try:
-        data = json.loads(candidate, strict=False)  # tolerate raw newlines inside strings
+        data = loads_bounded(candidate, strict=False)  # tolerate raw newlines inside strings
     except json.JSONDecodeError as exc:
         raise ValueError(f"it is not valid JSON ({exc.msg} at character {exc.pos})") from exc
     try:
@@ -186,6 +222,9 @@ class BackendModel(ChatModel):
             completion = self._call(request, "structured", prompt_version)
             try:
                 return parse_structured(completion.text, schema)
+            except TooDeep as exc:  # hostile, not a slip to repair
+                self.usage.record_error()
+                raise AnswerTooDeepError(f"{self.name} answered JSON whose {exc}; not parsed") from None
             except ValueError as exc:
                 reason = str(exc)
                 if completion.finish_reason == "length":
@@ -217,8 +256,11 @@ class BackendModel(ChatModel):
         started = time.perf_counter()
         key = None
         if self.cache is not None and self.cache.mode != "off":
-            key = self.cache.key(self.backend.kind, self.backend.model_name, request, prompt_version)
+            b = self.backend
+            key = self.cache.key(b.kind, b.model_name, request, prompt_version, b.server)
             hit = self.cache.get(key)
+            if hit is None and b.server is not None and getattr(self.cache, "legacy_keys", False):  # recorded before keys named servers
+                hit = self.cache.get(self.cache.key(b.kind, b.model_name, request, prompt_version))
             if hit is not None:
                 self.usage.record(self._record(kind, hit, started, cache_hit=True))
                 return hit

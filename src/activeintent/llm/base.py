@@ -67,8 +67,22 @@ class ModelUnavailableError(ModelError):
     """The model cannot be reached or does not exist (no server, unknown model, bad key)."""
 
 
+class ModelRedirectError(ModelError):
+    """The server answered with a redirect. Not followed: the prompt would go to another server
+    (``location`` says which), so the caller decides whether to point ``--base-url`` there."""
+
+    def __init__(self, message: str, *, location: str = "") -> None:
+        super().__init__(message)
+        self.location = location
+
+
 class StructuredOutputError(ModelError):
     """The model's answer did not parse/validate against the schema, even after repair rounds."""
+
+
+class AnswerTooDeepError(ModelError):
+    """The model's JSON nests deeper than any answer needs (``backend.MAX_JSON_DEPTH``): refused
+    unparsed and not repaired, an error of the call rather than an unusable answer."""
 
 
 class ImagesNotSupportedError(ModelError):

@@ -1,7 +1,8 @@
 """Content-addressed response cache in SQLite.
 
-The key is the sha256 of backend, model name, messages (images by their sha256), sampling
-parameters, schema and the caller's prompt-template version, so two runs with the same seed
+The key is the sha256 of backend, model name, the server's base URL (model servers only),
+messages (images by their sha256), sampling parameters, schema and the caller's prompt-template
+version, so two runs with the same seed
 and a warm cache make identical calls and get identical answers. Several processes on one
 machine may write to one file (WAL journal, busy timeout). WAL needs every process on the
 same host: workers on several machines use one cache file each on a local disk, merged
@@ -36,8 +37,15 @@ def check_mode(mode: str) -> CacheMode:
     return mode  # type: ignore[return-value]
 
 
-def request_fingerprint(backend: str, model: str, request: ChatRequest, prompt_version: str) -> dict:
-    """The canonical, JSON-able content the key hashes (images replaced by their sha256)."""
+# Set to 1: also read entries recorded before keys named the server (see ResponseCache).
+ENV_LEGACY_KEYS = "ACTIVEINTENT_CACHE_LEGACY_KEYS"
+
+
+def request_fingerprint(backend: str, model: str, request: ChatRequest, prompt_version: str,
+                        server: str | None = None) -> dict:
+    """The canonical, JSON-able content the key hashes (images replaced by their sha256).
+    ``server``: the base URL of a model server (None for an in-process model: its keys are as
+    they always were); two servers serving a model of one name are two models."""
     messages = []
     for m in request.messages:
         if isinstance(m.content, str):
@@ -50,7 +58,9 @@ def request_fingerprint(backend: str, model: str, request: ChatRequest, prompt_v
                 for p in m.content
             ]
         messages.append({"role": m.role, "content": content})
+    server_part = {} if server is None else {"server": server}
     return {
+        **server_part,
         "backend": backend,
         "model": model,
         "messages": messages,
@@ -80,10 +90,16 @@ CREATE TABLE IF NOT EXISTS responses (
 
 class ResponseCache:
     """``record`` (default): answer from the cache, call the model on a miss and store it;
-    ``replay``: a miss is a :class:`CacheMissError`; ``off``: neither read nor write."""
+    ``replay``: a miss is a :class:`CacheMissError`; ``off``: neither read nor write.
 
-    def __init__(self, path: str | Path | None = None, mode: str = "record") -> None:
+    Keys of a model server's answers name its base URL. Entries recorded before that (keys
+    without a server) are not read, since they may come from any server serving a model of that
+    name; ``legacy_keys`` (default: the environment variable ACTIVEINTENT_CACHE_LEGACY_KEYS=1)
+    reads them when no entry of the server is found. They are never written."""
+
+    def __init__(self, path: str | Path | None = None, mode: str = "record", *, legacy_keys: bool | None = None) -> None:
         self.mode: CacheMode = check_mode(mode)
+        self.legacy_keys = os.environ.get(ENV_LEGACY_KEYS, "") == "1" if legacy_keys is None else legacy_keys
         self.path = Path(path).expanduser() if path is not None else default_cache_path()
         self._lock = threading.Lock()
         self._conn: sqlite3.Connection | None = None
@@ -103,9 +119,9 @@ class ResponseCache:
         return self._conn
 
     @staticmethod
-    def key(backend: str, model: str, request: ChatRequest, prompt_version: str = "") -> str:
+    def key(backend: str, model: str, request: ChatRequest, prompt_version: str = "", server: str | None = None) -> str:
         blob = json.dumps(
-            request_fingerprint(backend, model, request, prompt_version),
+            request_fingerprint(backend, model, request, prompt_version, server),
             sort_keys=True,
             separators=(",", ":"),
             ensure_ascii=False,

@@ -8,8 +8,10 @@ retried here with exponential backoff and jitter, then raised as typed errors.
 
 Every call is bounded (:class:`CallLimits`): a connect timeout, an overall deadline over all its
 attempts and waits (enforced on every socket read and write, so a server that drips bytes
-cannot stretch it), and a cap on the bytes read. The body is parsed here, strictly: anything
-but UTF-8 JSON of the chat-completions shape with finite, whole token counts is a ModelError.
+cannot stretch it), and a cap on the bytes read. Bodies are asked for uncompressed and a
+compressed one is refused unread (the cap counts bytes on the wire); redirects are refused, not
+followed. The body is parsed here, strictly: anything but UTF-8 JSON of the chat-completions
+shape, nested at most MAX_JSON_DEPTH deep, with finite, whole token counts is a ModelError.
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ from activeintent.llm.backend import (
     Backend,
     ChatRequest,
     Completion,
+    loads_bounded,
     schema_instruction,
     with_instruction,
 )
@@ -41,6 +44,7 @@ from activeintent.llm.base import (
     ImagePart,
     Message,
     ModelError,
+    ModelRedirectError,
     ModelUnavailableError,
     TransientModelError,
 )
@@ -51,6 +55,7 @@ from activeintent.llm.retry import RetryOutcome, RetryPolicy, Transient, run_wit
 # takes (it turns the schema into a grammar).
 FORMAT_MODES = ("json_schema", "json_object_schema", "json_object", "text")
 DUMMY_API_KEY = "sk-no-key-needed"
+DEFAULT_BASE_URL = "https://api.openai.com/v1"  # the SDK's, when no base URL is given
 
 # Environment variables that set CallLimits (forwarded to bench workers, Ray's too).
 ENV_CONNECT_S = "ACTIVEINTENT_MODEL_CONNECT_S"
@@ -162,9 +167,42 @@ def _bounded_client(base_url: str | None, budget: _Budget, limits: CallLimits, r
     url = urlsplit(base_url or "https://api.openai.com/v1")
     proxies = urllib.request.getproxies()
     proxy = None if urllib.request.proxy_bypass(url.hostname or "") else proxies.get(url.scheme)
-    transport = httpx2.HTTPTransport(proxy=proxy)
+    transport = _GuardedTransport(proxy=proxy)
     transport._pool._network_backend = _BoundedBackend(budget)  # noqa: SLF001
-    return openai.DefaultHttpxClient(transport=transport, timeout=httpx2.Timeout(read_s, connect=limits.connect_s))
+    return openai.DefaultHttpxClient(transport=transport, timeout=httpx2.Timeout(read_s, connect=limits.connect_s),
+                                     follow_redirects=False)
+
+
+class _Refusal(openai.OpenAIError):
+    """An answer this client will not read (the SDK passes its own errors through unwrapped)."""
+
+
+class _Compressed(_Refusal):
+    pass
+
+
+class _Redirected(_Refusal):
+    def __init__(self, code: int, location: str) -> None:
+        super().__init__(f"HTTP {code} redirect")
+        self.code, self.location = code, location
+
+
+class _GuardedTransport(httpx2.HTTPTransport):
+    """Asks for an uncompressed body and refuses any other before reading a byte of it (the size
+    cap counts bytes on the wire: a small gzip body could inflate to gigabytes past it); refuses
+    redirects, which would send the whole prompt to another server."""
+
+    def handle_request(self, request: httpx2.Request) -> httpx2.Response:
+        request.headers["Accept-Encoding"] = "identity"
+        response = super().handle_request(request)
+        encoding = response.headers.get("content-encoding", "").strip().lower()
+        if encoding not in ("", "identity"):
+            response.close()
+            raise _Compressed(encoding)
+        if 300 <= response.status_code < 400:
+            response.close()
+            raise _Redirected(response.status_code, response.headers.get("location", ""))
+        return response
 
 
 class _Strict(BaseModel):
@@ -205,7 +243,7 @@ def parse_answer(body: bytes) -> _Answer:
     except UnicodeDecodeError as exc:
         raise ValueError(f"the body is not UTF-8 ({exc.reason} at byte {exc.start})") from None
     try:
-        data = json.loads(text, parse_constant=_not_a_number)
+        data = loads_bounded(text, parse_constant=_not_a_number)
     except ValueError as exc:
         raise ValueError(f"the body is not JSON ({exc}): {text[:80]!r}") from None
     try:
@@ -298,6 +336,7 @@ class OpenAIBackend(Backend):
             api_key = DUMMY_API_KEY
         self.model_name = model
         self.base_url = base_url
+        self.server = (base_url or DEFAULT_BASE_URL).rstrip("/")
         self.accepts_images = accepts_images
         self.seed = seed
         self.retry = retry or RetryPolicy()
@@ -356,6 +395,12 @@ class OpenAIBackend(Backend):
             self._budget.start(self._deadline, self.limits.max_response_bytes)
             try:
                 raw = self.client.chat.completions.with_raw_response.create(**kwargs)
+            except _Compressed as exc:
+                raise _TooLarge(f"openai:{self.model_name} at {self.where} sent a body compressed with {str(exc)[:40]!r} "
+                                "although asked for none (Accept-Encoding: identity); compressed answers are not "
+                                "read, since a small one can inflate past the size cap") from None
+            except _Redirected as exc:
+                raise self._redirect(exc) from None
             except openai.APITimeoutError as exc:
                 raise self._bounded(exc) or Transient("timed out") from exc
             except openai.APIConnectionError as exc:
@@ -414,6 +459,13 @@ class OpenAIBackend(Backend):
             return Transient(f"the {self.limits.deadline_s:g} s deadline passed", final=True)
         return None
 
+    def _redirect(self, exc: _Redirected) -> ModelRedirectError:
+        where = repr(exc.location[:300]) if exc.location else "(no Location header)"  # repr: escapes controls
+        return ModelRedirectError(
+            f"openai:{self.model_name} at {self.where} answered HTTP {exc.code}, a redirect to {where}; redirects "
+            "are not followed (the prompt would go to another server): if you trust that server, give it as "
+            "--base-url", location=exc.location[:300])
+
     def _too_large(self) -> str:
         return (f"openai:{self.model_name} at {self.where}: the answer is larger than the "
                 f"{self.limits.max_response_bytes} bytes cap ({ENV_MAX_BYTES}); not read further")
@@ -444,7 +496,7 @@ class _Refused(Exception):
 
 
 class _TooLarge(Exception):
-    """An answer past the size cap: not retried (the next would be as large)."""
+    """An answer past the size cap, or compressed: not retried (the next would be the same)."""
 
 
 def _error_detail(exc: openai.APIStatusError) -> str:

@@ -25,6 +25,7 @@ import asyncio
 import errno
 import json
 import logging
+import re
 import resource
 import time
 from collections import Counter
@@ -39,6 +40,7 @@ from activeintent.web.errors import RateLimitedLog, error_body
 log = logging.getLogger("activeintent.web")
 
 MAX_HEAD_BYTES = 16 * 1024  # a request line and headers; the pages send well under 2 KiB
+_HEAD_END = re.compile(rb"\r?\n\r?\n")  # h11 also takes bare newlines
 KEEP_ALIVE_S = 5  # an idle connection after an answer is closed after this long
 OUT_OF_FDS = (errno.EMFILE, errno.ENFILE)
 
@@ -59,7 +61,7 @@ def connection_budget(max_connections: int) -> tuple[int, int | None]:
 def canned(status: int, code: str, message: str, retry_after: int | None = None) -> bytes:
     """A whole HTTP/1.1 answer in the API's error shape, for a connection the app never sees."""
     body = json.dumps(error_body(status, code, message)).encode()
-    phrase = {408: "Request Timeout", 503: "Service Unavailable"}[status]
+    phrase = {408: "Request Timeout", 431: "Request Header Fields Too Large", 503: "Service Unavailable"}[status]
     head = [f"HTTP/1.1 {status} {phrase}", "Content-Type: application/json",
             f"Content-Length: {len(body)}", "Connection: close"]
     if retry_after is not None:
@@ -89,6 +91,8 @@ class ConnectionGuard:
                                "open, as many as one client may; close some or try again", retry_after=5)
         self.timeout = canned(408, "request_timeout",
                               f"no complete request head within {header_timeout:g} s; the connection is closed")
+        self.head_too_large = canned(431, "head_too_large", f"the request head is larger than {MAX_HEAD_BYTES} "
+                                     "bytes (request line and headers); the connection is closed")
 
     # -- connections ---------------------------------------------------------------------------
     def protocol(self, **uvicorn_kwargs: Any) -> GuardedConnection:
@@ -145,6 +149,10 @@ class GuardedConnection(asyncio.Protocol):
         self.requests = 0  # in progress on this connection (pipelined ones may overlap briefly)
         self._timer: asyncio.Handle | None = None
         self._partial = False  # bytes arrived since the wait for a request head began
+        self._head_bytes = 0  # of the request head being waited for, however it arrives
+        self._in_head = True  # waiting for a head's end (else: a request's body, or nothing)
+        self._tail = b""  # the last bytes seen, for an end of head split across reads
+        self._refused = False  # its head was too large: answered 431 and closing
 
     def connection_made(self, transport: asyncio.BaseTransport) -> None:
         self.transport = transport  # type: ignore[assignment]
@@ -162,10 +170,16 @@ class GuardedConnection(asyncio.Protocol):
         self._wait_for_head()
 
     def data_received(self, data: bytes) -> None:
-        if not self.admitted:
+        if not self.admitted or self._refused:
             return
         if self._timer is not None:
             self._partial = True
+        if self._in_head and self._head_too_large(data):
+            self._refused = True  # nothing more of it reaches the HTTP layer
+            self._cancel()
+            self.transport.write(self.guard.head_too_large)
+            self.transport.close()
+            return
         try:
             self.inner.data_received(data)
         except Exception as err:  # the HTTP layer could not answer this itself: end the connection
@@ -200,10 +214,25 @@ class GuardedConnection(asyncio.Protocol):
         if self.requests == 0 and not self.transport.is_closing():
             self._wait_for_head()
 
+    def _head_too_large(self, data: bytes) -> bool:
+        """Count the bytes of the head being waited for, up to its end (an empty line): h11's
+        own limit binds only a head that is still incomplete after a read, so a head of any size
+        sent in one piece went through."""
+        window = self._tail + data
+        end = _HEAD_END.search(window)
+        if end is None:
+            self._head_bytes += len(data)
+            self._tail = window[-3:]
+            return self._head_bytes > MAX_HEAD_BYTES
+        self._head_bytes += end.end() - len(self._tail)
+        self._in_head = False
+        return self._head_bytes > MAX_HEAD_BYTES
+
     # -- the header timeout ---------------------------------------------------------------------
     def _wait_for_head(self) -> None:
         self._cancel()
         self._partial = False
+        self._head_bytes, self._in_head, self._tail = 0, True, b""
         self._timer = asyncio.get_running_loop().call_later(self.guard.header_timeout, self._expired)
 
     def _cancel(self) -> None:
