@@ -169,7 +169,7 @@ def test_free_rule_session_questionnaire_and_guess_shown_always(live_server, htt
     srv = live_server("bayes-stop", rounds=2, seed=2, video_size=(64, 64), show_estimate="always")
     api = f"{srv.url}/api"
     config = httpx.get(f"{api}/config").json()
-    assert config["design"] == "free-rule" and config["intention"] is None
+    assert config["design"] == "free-rule" and "intention" not in config and "method" not in config
     assert config["intention_description"] is None and config["show_estimate"] == "always"
     sid = http.post(f"{api}/sessions", json={"participant": "P-free"}).json()["id"]
     folder = srv.session_dir(sid)
@@ -239,7 +239,7 @@ def test_assigned_rule_is_shown_scored_and_exported_with_hidden_guesses(live_ser
     srv = live_server("bayes-preference", rounds=1, seed=3, video_size=(64, 64), intention="color-match")
     api = f"{srv.url}/api"
     config = httpx.get(f"{api}/config").json()
-    assert config["design"] == "assigned-rule" and config["intention"] == "color-match"
+    assert config["design"] == "assigned-rule" and "intention" not in config  # the rule's name: never
     assert config["intention_description"] == "Put each block in the bowl of the same colour."
     assert config["show_estimate"] == "hidden" and config["video_size"] == [64, 64]
     sid = http.post(f"{api}/sessions", json={"participant": "P-assigned"}).json()["id"]

@@ -28,7 +28,8 @@ SESSION_COLUMNS = [
     "button_order", "key_id", "created", "ended", "status", "design", "intention", "intention_description",
     "method", "signal", "show_estimate", "video_size", "seed", "rounds_planned", "rounds_answered",
     "signals_used", "answers", "answer_seconds_total", "session_seconds", "success", "success_basis",
-    "final_guess", "final_scene", "final_scene_index", "final_scene_feasible", "error", "questionnaire_final_attempt", "questionnaire_rule", "questionnaire_comments",
+    "final_guess", "final_scene", "final_scene_index", "final_scene_feasible", "error", "final_video_watched", "final_video_seconds",
+    "questionnaire_final_attempt", "questionnaire_rule", "questionnaire_comments",
     "questionnaire_submitted",
 ]
 ROUND_COLUMNS = ["participant", "key", "answer", "stop_time", "viewing", "after_end_presses", "response_s", "counted", "guess"]
@@ -173,6 +174,9 @@ def session_record(folder: Path) -> dict:
         "final_scene_index": info.get("final_scene_index"),
         "final_scene_feasible": info.get("final_scene_feasible"),
         "error": info.get("error") or summary.get("error"),
+        # whether the final attempt's video was watched before the questions opened, and how long
+        "final_video_watched": questionnaire.get("final_video_watched"),
+        "final_video_seconds": questionnaire.get("final_video_seconds"),
         "questionnaire_final_attempt": questionnaire.get("final_attempt"),
         "questionnaire_rule": questionnaire.get("rule"),
         "questionnaire_comments": questionnaire.get("comments"),
