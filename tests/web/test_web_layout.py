@@ -205,3 +205,35 @@ def test_a_refused_start_reads_as_a_message_for_participants(live_server, page):
     assert "already has a study session open" in text
     assert "limit" not in text and "per client" not in text  # not the server's sentence
     assert page.is_enabled("#start")
+
+
+def test_a_stalled_video_is_recorded_per_round_and_exported(live_server, page, tmp_path):
+    """A throttled video route: round 1's video is held back until after Ready, so playback waits
+    for it (a stall at t = 0, as on a slow connection); the export has the stall and its length."""
+    srv = live_server("bayes-stop", rounds=1, seed=4, video_size=(64, 64))
+    held = []
+
+    def hold(route):
+        held.append(route)  # answered later, by the test: the video does not arrive yet
+
+    page.route("**/files/round1_y.webm", hold)
+    enter(page, srv.url + "/", "P-stall")
+    page.click("#start")
+    page.wait_for_url("**/signal/stop?session=*")
+    sid = session_id(page)
+    wait_round(page, 1)
+    page.wait_for_selector("#ready:enabled")
+    page.click("#ready")
+    page.wait_for_timeout(1500)  # playback asked for, no frames: stalled
+    assert held, "the video was never requested"
+    for route in held:
+        route.fulfill(response=route.fetch())
+    page.unroute("**/files/round1_y.webm")
+    page.wait_for_function("document.getElementById('video').currentTime > 0")
+    page.click("#new-scene")
+    page.wait_for_url("**/done?session=*")
+    session = srv.manager.get(sid)
+    assert session.join(60)
+    page.wait_for_timeout(1200)  # the page's event batch
+    (row,) = export(srv.out, tmp_path / "stall.csv")
+    assert int(row["round1_stalls"]) >= 1 and float(row["round1_stall_s"]) >= 1.0, row

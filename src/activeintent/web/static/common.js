@@ -251,6 +251,20 @@ const Study = (() => {
       video.addEventListener(type, () =>
         log(`video_${type}`, { video: label, time: video.currentTime, duration: video.duration }, roundOf()));
     }
+    // A stall: from "waiting" until frames flow again ("playing"), or until the round's answer
+    // ends it (video_stall_open); one video_stall event each, with its length (export: per round).
+    let stalled = null;
+    video.addEventListener("waiting", () => {
+      if (stalled === null) stalled = { at: video.currentTime, since: now(), round: roundOf() };
+    });
+    const endStall = (how) => {
+      if (stalled === null) return;
+      const s = stalled;
+      stalled = null;
+      log("video_stall", { video: label, at: s.at, seconds: Math.round((now() - s.since) * 1000) / 1000, how }, s.round);
+    };
+    video.addEventListener("playing", () => endStall("resumed"));
+    video.addEventListener("emptied", () => endStall("replaced")); // the next round's video
   }
 
   // Play a video again from its start. A video sent while it was still being drawn cannot be
