@@ -95,3 +95,69 @@ def test_a_bench_record_replays_with_its_seed_and_test_seed(tmp_path):
     res = runner.invoke(app, [*args, "--out", str(tmp_path / "own")])  # the test scenes follow --seed alone
     own = json.loads((tmp_path / "own" / "summary.json").read_text())
     assert (own["success_at"], own["test_scored"]) != (record["success_at"], record["test_scored"])
+
+
+def _round_log(round_: int, z: str, signals: int, goal: str = "put the red block in the red bowl"):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(round=round_, z=z, counted=True, signals_used=signals, labels=["y"], goals=[goal],
+                           retrieved=None, calls=[],
+                           answer={"signal": "stop", "stop_time": 1.5, "tick": 3, "frame": 15, "new_scene": False})
+
+
+def _table_rows(live) -> list[list[str]]:
+    return [[str(c._cells[i]) for c in live.table.columns] for i in range(live.table.row_count)]
+
+
+def test_table_row_k_shows_round_k_answer_and_the_estimate_after_it():
+    """Row k: round k's answer beside the estimate after it (the next round's z, or the final
+    one), which is what success@k scores; and every round that happened has its row, scored or
+    not (slow learners are scored at k = K only)."""
+    from types import SimpleNamespace
+
+    from activeintent.run_command import LiveTable, plain_console
+
+    final = SimpleNamespace(final_z="z after 2", final_goal="g", final_scene=0, success=1.0)
+    live = LiveTable(plain_console(), "bayes-stop", 2, 0, lines=False)
+    live.answered(_round_log(1, "prior z", 1))
+    live.scored(1, 0.5)
+    live.answered(_round_log(2, "z after 1", 2))
+    live.scored(2, 1.0)
+    live.final(final)
+    rows = _table_rows(live)
+    assert [r[0] for r in rows] == ["1", "2", "final"]
+    z, rate = live.table.columns.index(next(c for c in live.table.columns if c.header.startswith("z"))), -1
+    assert (rows[0][z], rows[0][rate]) == ("z after 1", "0.50")
+    assert (rows[1][z], rows[1][rate]) == ("z after 2", "1.00")
+    assert rows[2][1].startswith("test scene 1: ")  # scenes are numbered from 1 where printed
+    # no scoring between rounds (a model-driven learner): the rounds still show
+    slow = LiveTable(plain_console(), "preference", 3, 0, lines=False)
+    for k in (1, 2, 3):
+        slow.answered(_round_log(k, f"z{k}", k))
+    slow.flush()  # e.g. a model error after round 3
+    assert [r[0] for r in _table_rows(slow)] == ["1", "2", "3"]
+
+
+def test_user_strings_print_without_markup_and_messages_whole():
+    import io
+
+    from activeintent.run_command import model_summary, plain_console
+
+    console = plain_console()
+    console.file = io.StringIO()
+    long = "the server said: " + "word " * 60 + "END"
+    console.print(f"{model_summary('openai:x', 3, [long])} · done", soft_wrap=True)
+    text = console.file.getvalue()
+    assert "openai:x: 3 calls" in text and "❌" not in text  # ":x:" is no emoji here
+    assert long in text  # the whole failure message, not cut mid-word
+
+
+def test_piped_tables_are_wide_and_video_final_says_why_there_is_no_gif(tmp_path):
+    res = runner.invoke(app, ["run", "--method", "lang-stop", "--llm", "none", "--env", "symbolic", "--budget", "1",
+                              "--test-scenes", "2", "--test-pool", "0", "--video", "final", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    assert not (tmp_path / "final.gif").exists()
+    assert "no final.gif: the symbolic env draws no pictures" in res.output
+    lines = res.output.splitlines()
+    header = next(line for line in lines if "z (estimate after the answer)" in line)
+    assert len(header) > 80  # not wrapped to 80 columns when piped

@@ -189,3 +189,13 @@ def test_a_plugin_file_registers_an_intention_that_names_resolve(tmp_path):
     assert intention.name == name and intention.description == "Nothing ever pleases this user."
     assert suite_of(name) == "plugin"
     assert name not in INTENTION_NAMES  # the library suite stays the built-in one
+
+
+def test_an_intention_file_takes_the_registered_name_as_well_as_the_class(tmp_path):
+    """`--intention-file FILE:rightmost-bowl` (the name `intentions` prints) as well as FILE:RightmostBowl."""
+    body = GOOD_BODY.format(name_line='name = "never-ever"')
+    path = write(tmp_path, body)
+    assert load_intention_file(f"{path}:never-ever").name == "never-ever"
+    assert load_intention_file(f"{path}:Never").name == "never-ever"
+    with pytest.raises(IntentionError, match="defines no 'always'"):
+        load_intention_file(f"{path}:always")

@@ -43,6 +43,13 @@ def test_serve_names_the_design_and_configures_the_study(tmp_path, monkeypatch):
     assert "model none" in said  # a method that needs no model gets none unless --llm is given
     bad = runner.invoke(app, ["serve", "--method", "bayes-stop", "--video-size", "800x", "--out", str(tmp_path)])
     assert bad.exit_code != 0 and "WIDTHxHEIGHT" in " ".join(bad.output.split())
+    lab = runner.invoke(app, ["serve", "--method", "bayes-stop", "--shared-client", "10.1.2.0/24",
+                              "--reconnect-grace", "30", "--out", str(tmp_path)])
+    assert lab.exit_code == 0, lab.output
+    limits = served[-1].state.limits.limits
+    assert limits.shared("10.1.2.77") and not limits.shared("10.1.3.1") and limits.reconnect_grace == 30
+    wrong = runner.invoke(app, ["serve", "--method", "bayes-stop", "--shared-client", "lab-pc", "--out", str(tmp_path)])
+    assert wrong.exit_code != 0 and "not an address or network" in " ".join(wrong.output.split())
     res = runner.invoke(app, ["serve", "--method", "bayes-stop", "--video-size", "640x360", "--out", str(tmp_path)])
     assert res.exit_code == 0 and served[-1].state.manager.config.video_size == (640, 360), res.output
     res = runner.invoke(app, ["serve", "--method", "bayes-preference", "--intention", "color-match",
@@ -82,8 +89,8 @@ def test_serve_binds_loopback_and_answers(tmp_path):
             except httpx.TransportError:
                 time.sleep(0.2)
         assert config == {"study": False, "consent": None, "require_pid": False,
-                          "url_parameters": ["pid", "PROLIFIC_PID", "STUDY_ID", "SESSION_ID"], "method": "bayes-stop", "signal": "stop", "rounds": 3, "design": "free-rule",
-                          "intention": None, "intention_description": None, "show_estimate": "hidden",
+                          "url_parameters": ["pid", "PROLIFIC_PID", "STUDY_ID", "SESSION_ID"], "rounds": 3, "design": "free-rule",
+                          "intention_description": None, "show_estimate": "hidden",
                           "fps": 10, "video_size": [128, 128]}
         page = httpx.get(f"http://127.0.0.1:{port}/")
         assert page.status_code == 200 and "Teach the robot" in page.text

@@ -64,7 +64,8 @@ def test_preference_api_accepts_a_valid_answer_and_rejects_bad_ones(live_server,
     assert created.status_code == 201
     sid = created.json()["id"]
     state = waiting_state(srv.url, sid, 1)
-    assert state["signal"] == "preference" and state["rounds"] == 2 and state["progress"] == 1
+    assert state["page"] == "/signal/preference" and state["rounds"] == 2 and state["progress"] == 1
+    assert "method" not in state and "intention" not in state  # nothing a participant could read their condition in
     assert [v["label"] for v in state["question"]["videos"]] == ["A", "B"]
     assert state["estimate"] is None  # hidden by default, and never before the first answer
     for v in state["question"]["videos"]:
@@ -256,8 +257,8 @@ def test_openapi_describes_the_api(live_server):
             "/api/sessions/{sid}/files/{name}"} <= paths
     config = httpx.get(f"{srv.url}/api/config").json()
     assert config == {"study": False, "consent": None, "require_pid": False,
-                      "url_parameters": ["pid", "PROLIFIC_PID", "STUDY_ID", "SESSION_ID"], "method": "bayes-stop", "signal": "stop", "rounds": 1, "design": "free-rule",
-                      "intention": None, "intention_description": None, "show_estimate": "hidden", "fps": 10,
+                      "url_parameters": ["pid", "PROLIFIC_PID", "STUDY_ID", "SESSION_ID"], "rounds": 1, "design": "free-rule",
+                      "intention_description": None, "show_estimate": "hidden", "fps": 10,
                       "video_size": [800, 600]}
 
 

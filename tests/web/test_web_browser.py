@@ -212,8 +212,19 @@ def export(out: Path, to: Path) -> list[dict]:
     return list(csv.DictReader(to.open(newline="")))
 
 
+def watch_final(page) -> None:
+    """Play the final attempt to its end (the questions open only then), quickly: from near it."""
+    if page.get_attribute("#questionnaire", "data-locked") != "true":
+        return
+    page.wait_for_function("Number.isFinite(document.getElementById('final').duration)")
+    page.evaluate("() => { const v = document.getElementById('final'); v.currentTime = Math.max(0, v.duration - 0.3); "
+                  "v.play(); }")
+    page.wait_for_selector("#q-submit:enabled")
+
+
 def answer_questionnaire(page, final_attempt: str, rule: str, comments: str) -> None:
     page.wait_for_selector("#questionnaire:visible")
+    watch_final(page)
     page.click("#q-submit")  # nothing chosen yet: the page asks first and sends nothing
     assert "Please answer" in page.inner_text("#q-status")
     page.get_by_role("radio", name=final_attempt.capitalize(), exact=True).check()

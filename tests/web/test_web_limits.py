@@ -123,3 +123,54 @@ def test_serve_options_set_the_limits(tmp_path, monkeypatch):
         res = CliRunner().invoke(cli, ["serve", "--method", "bayes-stop", "--out", str(tmp_path / "x"), *bad])
         assert res.exit_code != 0, bad
     assert not (tmp_path / "x").exists()
+
+
+def test_a_session_takes_its_slot_at_start_and_a_closed_page_frees_it(live_server, fake_clock):
+    """Agreeing only enrols (no slot, no episode); Start takes the slot; a page's beacon on unload
+    frees it after the reconnect grace unless a page of the session asks again."""
+    clock = fake_clock
+    srv = live_server("bayes-stop", rounds=2, seed=1, video_size=(64, 64), clock=clock,
+                      limits={"max_sessions_per_client": 1, "idle_timeout": 600, "reconnect_grace": 20})
+    api = f"{srv.url}/api"
+    with client("127.0.0.1") as a:
+        first = a.post(f"{api}/sessions", json={"start": False}).json()
+        second = a.post(f"{api}/sessions", json={"start": False}).json()
+        assert first["status"] == second["status"] == "enrolled"  # two agreed: neither holds the slot
+        assert not srv.manager.get(first["id"]).running
+        started = a.post(f"{api}/sessions/{first['id']}/start")
+        assert started.status_code == 200 and started.json()["status"] != "enrolled"
+        refused = a.post(f"{api}/sessions/{second['id']}/start")
+        assert refused.status_code == 429 and error(refused)["code"] == "too_many_sessions"
+        waiting(a, srv.url, first["id"])
+
+        # a reload (or the next page): the beacon, then a request of a page within the grace
+        assert a.post(f"{api}/sessions/{first['id']}/leave").status_code == 204
+        clock.advance(10)
+        a.get(f"{api}/sessions/{first['id']}")
+        clock.advance(15)
+        srv.limits.expire_idle()
+        assert srv.manager.get(first["id"]).running
+        # the tab closed: nothing comes back within the grace
+        assert a.post(f"{api}/sessions/{first['id']}/leave").status_code == 204
+        clock.advance(21)
+        again = a.post(f"{api}/sessions/{second['id']}/start")
+        assert again.status_code == 200, again.text  # the closed page's slot is free again
+        gone = srv.manager.get(first["id"])
+        assert gone.join(30) and gone.status == "cancelled" and "page closed" in gone.error
+        # a stranger's beacon (no key) changes nothing
+        with client("127.0.0.2") as b:
+            assert b.post(f"{api}/sessions/{second['id']}/leave").status_code == 403
+
+
+def test_shared_lab_addresses_are_not_limited_per_client(live_server, fake_clock):
+    srv = live_server("bayes-stop", rounds=1, seed=1, video_size=(64, 64), clock=fake_clock, max_sessions=3,
+                      limits={"max_sessions_per_client": 1, "max_new_sessions_per_hour": 1,
+                              "shared_clients": ["127.0.5.0/24"]})
+    api = f"{srv.url}/api"
+    with client("127.0.5.7") as lab:  # three lab PCs behind one address
+        for _ in range(3):
+            assert lab.post(f"{api}/sessions").status_code == 201
+        full = lab.post(f"{api}/sessions")
+        assert full.status_code == 503 and error(full)["code"] == "server_full"  # the server's own limit stays
+    with client("127.0.0.9") as other:
+        assert error(other.post(f"{api}/sessions"))["code"] == "server_full"

@@ -94,7 +94,12 @@ def _fake_session(root: Path, sid: str, created: float, design: str, rule: str |
     events = [{"source": "server", "type": "round_presented", "round": 1, "server_ts": created + 1},
               {"source": "server", "type": "answer", "round": 1, "server_ts": created + 4.5},
               {"source": "server", "type": "round_presented", "round": 2, "server_ts": created + 6},
-              {"source": "server", "type": "answer", "round": 2, "server_ts": created + 8}]
+              {"source": "server", "type": "answer", "round": 2, "server_ts": created + 8},
+              # the page's record of two stalls in round 2 (playback waited for frames)
+              {"source": "client", "type": "video_stall", "round": 2, "client_ts": created + 7,
+               "data": {"video": "A", "at": 0.0, "seconds": 1.25, "how": "resumed"}},
+              {"source": "client", "type": "video_stall", "round": 2, "client_ts": created + 7.5,
+               "data": {"video": "B", "at": 2.1, "seconds": 0.5, "how": "resumed"}}]
     (folder / "events.jsonl").write_text("".join(json.dumps(e) + "\n" for e in events) + '{"torn')
     (folder / "summary.json").write_text(json.dumps({"success": 1.0, "success_basis": "assigned-rule" if rule else
                                                      "none", "signals_used": 2, "final_z": "final guess"}))
@@ -117,11 +122,14 @@ def test_the_export_has_one_row_per_session_and_neutralises_formulas(tmp_path):
     assert [r["answer"] for r in first["rounds"]] == ["A", "new_scene"]
     assert [r["response_s"] for r in first["rounds"]] == [3.5, 2.0] and first["answer_seconds_total"] == 5.5
     assert first["session_seconds"] == 60 and first["questionnaire_final_attempt"] == "partly"
+    assert [(r["stalls"], r["stall_s"]) for r in first["rounds"]] == [(0, 0.0), (2, 1.75)]
+    assert first["stalls_total"] == 2 and first["stall_seconds_total"] == 1.75
 
     table = tmp_path / "study.csv"
     write_table(records, table)
     rows = list(csv.DictReader(table.open(newline="")))
     assert len(rows) == 2 and rows[0]["round2_answer"] == "new_scene" and rows[0]["round1_response_s"] == "3.5"
+    assert rows[0]["round2_stalls"] == "2" and rows[0]["round2_stall_s"] == "1.75"
     assert rows[0]["questionnaire_rule"] == "'=1+1 colours match"  # shown as text, not run
     assert rows[0]["participant"].startswith("'=") and rows[0]["questionnaire_comments"] == "nice\nrobot"
     assert rows[1]["success"] == "" and rows[1]["questionnaire_rule"] == ""
@@ -169,7 +177,7 @@ def test_free_rule_session_questionnaire_and_guess_shown_always(live_server, htt
     srv = live_server("bayes-stop", rounds=2, seed=2, video_size=(64, 64), show_estimate="always")
     api = f"{srv.url}/api"
     config = httpx.get(f"{api}/config").json()
-    assert config["design"] == "free-rule" and config["intention"] is None
+    assert config["design"] == "free-rule" and "intention" not in config and "method" not in config
     assert config["intention_description"] is None and config["show_estimate"] == "always"
     sid = http.post(f"{api}/sessions", json={"participant": "P-free"}).json()["id"]
     folder = srv.session_dir(sid)
@@ -239,7 +247,7 @@ def test_assigned_rule_is_shown_scored_and_exported_with_hidden_guesses(live_ser
     srv = live_server("bayes-preference", rounds=1, seed=3, video_size=(64, 64), intention="color-match")
     api = f"{srv.url}/api"
     config = httpx.get(f"{api}/config").json()
-    assert config["design"] == "assigned-rule" and config["intention"] == "color-match"
+    assert config["design"] == "assigned-rule" and "intention" not in config  # the rule's name: never
     assert config["intention_description"] == "Put each block in the bowl of the same colour."
     assert config["show_estimate"] == "hidden" and config["video_size"] == [64, 64]
     sid = http.post(f"{api}/sessions", json={"participant": "P-assigned"}).json()["id"]

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import difflib
 import inspect
+import re
 from pathlib import Path
 
 from activeintent.intentions.arrangements import (
@@ -80,7 +81,8 @@ def _kebab(identifier: str) -> str:
 
 def _split_spec(spec: str) -> tuple[Path, str | None]:
     path, sep, attr = spec.rpartition(":")
-    if sep and attr.isidentifier() and path:
+    # NAME: a Python name in the file, or an intention's registered name (kebab-case)
+    if sep and path and (attr.isidentifier() or re.fullmatch(r"[A-Za-z_][A-Za-z0-9_-]*", attr)):
         return Path(path), attr
     return Path(spec), None
 
@@ -143,6 +145,11 @@ def load_intention_file(spec: str) -> Intention:
             )
         attr = candidates[0]
     if not hasattr(module, attr):
+        # the intention's registered name (what `intentions` prints), e.g. rightmost-bowl
+        named = [c for c in candidates if _name_of(getattr(module, c), c) == attr]
+        if len(named) == 1:
+            attr = named[0]
+    if not hasattr(module, attr):
         found = ", ".join(candidates) or "none"
         raise IntentionError(
             f"--intention-file {spec!r}: {path.name} defines no {attr!r} "
@@ -158,6 +165,17 @@ def load_intention_file(spec: str) -> Intention:
             "'one sentence saying what the user wants'."
         )
     return intention
+
+
+def _name_of(value: object, attr: str) -> str | None:
+    """The name an intention of the file goes by (its ``name``, else the kebab-case of ``attr``),
+    without running a factory."""
+    if isinstance(value, Intention):
+        return value.name or _kebab(attr)
+    if inspect.isclass(value):
+        name = getattr(value, "name", None)
+        return name if isinstance(name, str) and name else _kebab(attr)
+    return None
 
 
 def _instantiate(spec: str, attr: str, value: object) -> Intention:

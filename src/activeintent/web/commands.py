@@ -53,6 +53,8 @@ def serve(
     max_sessions_per_client: Annotated[int, typer.Option("--max-sessions-per-client", min=1, help="Sessions in progress at once from one client address")] = 2,
     max_new_sessions_per_hour: Annotated[int, typer.Option("--max-new-sessions-per-hour", min=1, help="Sessions one client address may start per hour")] = 30,
     idle_timeout: Annotated[float, typer.Option("--idle-timeout", min=0.1, help="Minutes without a request from a session's page before it is cancelled and its slot freed")] = 3.0,
+    reconnect_grace: Annotated[float, typer.Option("--reconnect-grace", min=1.0, help="Seconds a session whose page was closed (its unload beacon) waits for a page of it to come back before it is cancelled and its slot freed")] = 20.0,
+    shared_client: Annotated[list[str] | None, typer.Option("--shared-client", help="An address or network (CIDR) that several participants share, e.g. a lab's PCs behind one NAT address or a proxy: no per-client session limits for it (--max-sessions still holds). Repeatable")] = None,
     max_request_kb: Annotated[int, typer.Option("--max-request-kb", min=1, help="Largest request body in KiB")] = 128,
     events_quota_mb: Annotated[float, typer.Option("--events-quota-mb", min=0.01, help="Largest events.jsonl the browser may fill per session, in MiB")] = 5.0,
     header_timeout: Annotated[float, typer.Option("--header-timeout", min=0.5, help="Seconds a new or idle connection has to send a whole request head before it is closed")] = 10.0,
@@ -114,11 +116,19 @@ def serve(
             where = f"condition {name}: " if study_file else ""
             raise typer.BadParameter(where + str(err)) from None
     config = next(iter(configs.values()))
-    limits = Limits(max_sessions_per_client=max_sessions_per_client,
-                    max_new_sessions_per_hour=max_new_sessions_per_hour, idle_timeout=idle_timeout * 60,
-                    max_body_bytes=max_request_kb * 1024, events_quota_bytes=int(events_quota_mb * 2**20),
-                    header_timeout=header_timeout, body_timeout=body_timeout,
-                    max_connections_per_client=max_connections_per_client, max_connections=max_connections)
+    from pydantic import ValidationError
+
+    try:
+        limits = Limits(
+            max_sessions_per_client=max_sessions_per_client,
+            max_new_sessions_per_hour=max_new_sessions_per_hour, idle_timeout=idle_timeout * 60,
+            max_body_bytes=max_request_kb * 1024, events_quota_bytes=int(events_quota_mb * 2**20),
+            header_timeout=header_timeout, body_timeout=body_timeout,
+            max_connections_per_client=max_connections_per_client, max_connections=max_connections,
+            reconnect_grace=reconnect_grace, shared_clients=list(shared_client or []))
+    except ValidationError as err:
+        raise typer.BadParameter("; ".join(e["msg"].removeprefix("Value error, ") for e in err.errors()),
+                                 param_hint="--shared-client") from None
     if opt.check_only():
         return
     conditions = ({name: (c, runner_builder(c)) for name, c in configs.items()}

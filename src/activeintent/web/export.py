@@ -27,11 +27,13 @@ SESSION_COLUMNS = [
     "session", "participant", "pid", "study_id", "prolific_session_id", "condition", "consented",
     "button_order", "key_id", "created", "ended", "status", "design", "intention", "intention_description",
     "method", "signal", "show_estimate", "video_size", "seed", "rounds_planned", "rounds_answered",
-    "signals_used", "answers", "answer_seconds_total", "session_seconds", "success", "success_basis",
-    "final_guess", "final_scene", "final_scene_index", "final_scene_feasible", "error", "questionnaire_final_attempt", "questionnaire_rule", "questionnaire_comments",
+    "signals_used", "answers", "answer_seconds_total", "session_seconds", "stalls_total", "stall_seconds_total", "success", "success_basis",
+    "final_guess", "final_scene", "final_scene_index", "final_scene_feasible", "error", "final_video_watched", "final_video_seconds",
+    "questionnaire_final_attempt", "questionnaire_rule", "questionnaire_comments",
     "questionnaire_submitted",
 ]
-ROUND_COLUMNS = ["participant", "key", "answer", "stop_time", "viewing", "after_end_presses", "response_s", "counted", "guess"]
+ROUND_COLUMNS = ["participant", "key", "answer", "stop_time", "viewing", "after_end_presses", "response_s",
+                 "stalls", "stall_s", "counted", "guess"]
 FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
 
 
@@ -108,6 +110,13 @@ def session_record(folder: Path) -> dict:
     for e in events:
         if e.get("type") == "stop_after_end":
             late[e.get("round")] = late.get(e.get("round"), 0) + 1
+    # the videos' stalls as the page measured them (playback waiting for frames), per round
+    stalls: dict = {}
+    for e in events:
+        if e.get("type") == "video_stall" and e.get("source") == "client":
+            seconds = (e.get("data") or {}).get("seconds")
+            count, total = stalls.get(e.get("round"), (0, 0.0))
+            stalls[e.get("round")] = (count + 1, total + (seconds if isinstance(seconds, int | float) else 0.0))
     participant = info.get("participant")
 
     rounds = []
@@ -130,6 +139,8 @@ def session_record(folder: Path) -> dict:
             "viewing": (viewing.get(n) or "first") if label == "stop" else None,
             "after_end_presses": late.get(n, 0),
             "response_s": response,
+            "stalls": stalls.get(n, (0, 0.0))[0],
+            "stall_s": round(stalls.get(n, (0, 0.0))[1], 3),
             "counted": r.get("counted"),
             "guess": r.get("z"),  # the learner's z when this round was asked (not necessarily shown)
             "h": h,
@@ -166,6 +177,8 @@ def session_record(folder: Path) -> dict:
         "answer_seconds_total": round(sum(responses), 3) if responses else None,
         "session_seconds": round(ended - created, 3) if isinstance(created, int | float)
         and isinstance(ended, int | float) else None,
+        "stalls_total": sum(c for c, _ in stalls.values()),  # the final video's too
+        "stall_seconds_total": round(sum(t for _, t in stalls.values()), 3),
         "success": summary.get("success") if scored else None,
         "success_basis": (summary.get("success_basis") or "assigned-rule") if scored and summary else "none",
         "final_guess": summary.get("final_z") or None,
@@ -173,6 +186,9 @@ def session_record(folder: Path) -> dict:
         "final_scene_index": info.get("final_scene_index"),
         "final_scene_feasible": info.get("final_scene_feasible"),
         "error": info.get("error") or summary.get("error"),
+        # whether the final attempt's video was watched before the questions opened, and how long
+        "final_video_watched": questionnaire.get("final_video_watched"),
+        "final_video_seconds": questionnaire.get("final_video_seconds"),
         "questionnaire_final_attempt": questionnaire.get("final_attempt"),
         "questionnaire_rule": questionnaire.get("rule"),
         "questionnaire_comments": questionnaire.get("comments"),

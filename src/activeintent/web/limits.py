@@ -29,7 +29,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 from starlette.datastructures import Headers
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
@@ -70,6 +70,40 @@ class Limits(BaseModel):
     settle_seconds: float = Field(
         2.0, ge=0, description="how long a new session waits for idle sessions it cancelled to end"
     )
+    reconnect_grace: float = Field(
+        20.0, gt=0, description="seconds a session whose page said it was closing (a beacon on unload) "
+        "waits for a request from a page of it (a reload, the next page) before it is cancelled")
+    shared_clients: list[str] = Field(
+        default_factory=list, description="addresses or networks (CIDR) that several participants share (a lab "
+        "behind one address, a proxy): no per-client session limits for them, only --max-sessions")
+
+    @field_validator("shared_clients")
+    @classmethod
+    def _networks(cls, nets: list[str]) -> list[str]:
+        import ipaddress
+
+        for net in nets:
+            try:
+                ipaddress.ip_network(net, strict=False)
+            except ValueError:
+                raise ValueError(f"{net!r} is not an address or network (e.g. 10.0.0.5 or 10.0.0.0/24)") from None
+        return nets
+
+    def shared(self, client: str) -> bool:
+        """Whether ``client`` is one of the shared addresses."""
+        import ipaddress
+
+        try:
+            address = ipaddress.ip_address(client)
+        except ValueError:
+            return False
+        for net in self.shared_clients:
+            try:
+                if address in ipaddress.ip_network(net, strict=False):
+                    return True
+            except ValueError:
+                continue
+        return False
 
 
 # -- strict JSON --------------------------------------------------------------------------------
@@ -289,32 +323,23 @@ class SessionLimits:
         self._seen: dict[str, float] = {}  # session id -> clock time of the last request about it
         self._expired: set[str] = set()
         self._started: dict[str, deque[float]] = {}  # client -> clock times of its recent sessions
+        self._left: dict[str, float] = {}  # session id -> clock time its page said it was closing
 
     # -- admission ----------------------------------------------------------------------------
-    def create(self, client: str, participant: str | None = None, seed: int | None = None,
+    def create(self, client: str, participant: str | None = None, seed: int | None = None, start: bool = True,
                **enrol: Any) -> WebSession:
         """A new session for ``client``; ``enrol``: the URL's IDs and the consent (see
-        :meth:`SessionManager.create`)."""
-        cancelled = self.expire_idle()
-        deadline = time.monotonic() + self.limits.settle_seconds
-        for s in cancelled:  # their slots are free once their episodes have stopped
-            s.join(max(0.0, deadline - time.monotonic()))
+        :meth:`SessionManager.create`). ``start=False``: enrolled only (the start page's
+        agreement); it takes a slot only at :meth:`start`."""
+        if start:
+            self._settle()
         with self._lock:
             now = self.clock()
             started = self._started.setdefault(client, deque())
             while started and now - started[0] >= 3600:
                 started.popleft()
-            live = [s for s in self.manager.all() if s.active]
-            mine = [s for s in live if self._owner.get(s.id) == client]
-            retry = str(max(1, math.ceil(min(self.limits.idle_timeout, 60))))
-            if len(mine) >= self.limits.max_sessions_per_client:
-                raise ApiError(
-                    429, "too_many_sessions",
-                    f"this address has {len(mine)} sessions in progress (limit "
-                    f"{self.limits.max_sessions_per_client} per client); finish or close one first",
-                    headers={"Retry-After": retry},
-                )
-            if len(started) >= self.limits.max_new_sessions_per_hour:
+            shared = self.limits.shared(client)
+            if not shared and len(started) >= self.limits.max_new_sessions_per_hour:
                 wait = math.ceil(3600 - (now - started[0]))
                 raise ApiError(
                     429, "session_rate_limited",
@@ -322,17 +347,55 @@ class SessionLimits:
                     f"{self.limits.max_new_sessions_per_hour}); try again in {wait} s",
                     headers={"Retry-After": str(max(1, wait))},
                 )
-            if len(live) >= self.max_sessions:
-                raise ApiError(
-                    503, "server_full",
-                    f"{len(live)} sessions are in progress (limit {self.max_sessions}); try again later",
-                    headers={"Retry-After": retry},
-                )
-            session = self.manager.create(participant=participant, seed=seed, **enrol)
+            if start:
+                self._check_room(client)
+            else:  # enrolled, not started: bounded per address too (they hold memory, not a slot)
+                waiting = [s for s in self.manager.all() if s.active and not s.begun
+                           and self._owner.get(s.id) == client]
+                if not shared and len(waiting) >= 4 * self.limits.max_sessions_per_client:
+                    raise ApiError(429, "too_many_sessions",
+                                   f"this address has {len(waiting)} sessions waiting for Start; start or close one",
+                                   headers={"Retry-After": "60"})
+            session = self.manager.create(participant=participant, seed=seed, start=start, **enrol)
             self._owner[session.id] = client
             self._seen[session.id] = now
             started.append(now)
             return session
+
+    def start(self, session: WebSession, client: str) -> WebSession:
+        """Start an enrolled session (the page's Start): the per-client and server limits apply now."""
+        if session.begun:
+            return session
+        self._settle()
+        with self._lock:
+            self._check_room(self._owner.get(session.id, client))
+            self._seen[session.id] = self.clock()
+            self._left.pop(session.id, None)
+            return self.manager.begin(session)
+
+    def _settle(self) -> None:
+        cancelled = self.expire_idle()
+        deadline = time.monotonic() + self.limits.settle_seconds
+        for s in cancelled:  # their slots are free once their episodes have stopped
+            s.join(max(0.0, deadline - time.monotonic()))
+
+    def _check_room(self, client: str) -> None:
+        live = [s for s in self.manager.all() if s.running]
+        mine = [s for s in live if self._owner.get(s.id) == client]
+        retry = str(max(1, math.ceil(min(self.limits.idle_timeout, 60))))
+        if not self.limits.shared(client) and len(mine) >= self.limits.max_sessions_per_client:
+            raise ApiError(
+                429, "too_many_sessions",
+                f"this address has {len(mine)} sessions in progress (limit "
+                f"{self.limits.max_sessions_per_client} per client); finish or close one first",
+                headers={"Retry-After": retry},
+            )
+        if len(live) >= self.max_sessions:
+            raise ApiError(
+                503, "server_full",
+                f"{len(live)} sessions are in progress (limit {self.max_sessions}); try again later",
+                headers={"Retry-After": retry},
+            )
 
     def forget_quiet_clients(self) -> None:
         """Drop the start times older than an hour (bounded memory for many addresses)."""
@@ -349,9 +412,17 @@ class SessionLimits:
     def touch(self, sid: str) -> None:
         with self._lock:
             self._seen[sid] = self.clock()
+            self._left.pop(sid, None)  # a page of it is open again (the next page, a reload)
+
+    def leave(self, sid: str) -> None:
+        """The session's page is going away (a beacon on unload): unless a page of it asks
+        again within ``reconnect_grace`` s, the session is cancelled and its slot freed."""
+        with self._lock:
+            self._left[sid] = self.clock()
 
     def expire_idle(self) -> list[WebSession]:
-        """Cancel the sessions in progress that nobody asked about for ``idle_timeout`` s."""
+        """Cancel the sessions in progress that nobody asked about for ``idle_timeout`` s, and
+        those whose page closed ``reconnect_grace`` s ago without coming back."""
         cancelled = []
         with self._lock:
             now = self.clock()
@@ -359,12 +430,20 @@ class SessionLimits:
                 if not s.active or s.id in self._expired:
                     continue
                 seen = self._seen.setdefault(s.id, now)
+                left = self._left.get(s.id)
                 if now - seen > self.limits.idle_timeout:
-                    self._expired.add(s.id)
-                    cancelled.append(s)
-        for s in cancelled:
-            s.cancel(f"no request about this session for {self.limits.idle_timeout:g} s (idle timeout)")
-        return cancelled
+                    why = f"no request about this session for {self.limits.idle_timeout:g} s (idle timeout)"
+                elif left is not None and now - left > self.limits.reconnect_grace:
+                    why = (f"its page was closed and did not come back within "
+                           f"{self.limits.reconnect_grace:g} s (page closed)")
+                else:
+                    continue
+                self._expired.add(s.id)
+                self._left.pop(s.id, None)
+                cancelled.append((s, why))
+        for s, why in cancelled:
+            s.cancel(why)
+        return [s for s, _ in cancelled]
 
     # -- events quota -------------------------------------------------------------------------
     @contextmanager

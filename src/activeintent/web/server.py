@@ -90,6 +90,8 @@ class NewSession(_Body):
     study_id: str | None = _url_id("STUDY_ID")
     prolific_session_id: str | None = _url_id("SESSION_ID")
     consent: bool | None = Field(None, description="the participant agreed to the study's consent text")
+    start: bool = Field(True, description="start the episode now; false: enrol only (the start page's "
+                        "agreement), and POST /api/sessions/{id}/start when the participant presses Start")
 
     @field_validator("pid", "study_id", "prolific_session_id")
     @classmethod
@@ -154,6 +156,11 @@ class QuestionnaireAnswers(_Body):
     rule: str = Field(min_length=1, max_length=MAX_RULE_CHARS,
                       description="the participant's rule in their own words")
     comments: str | None = Field(None, max_length=MAX_COMMENT_CHARS, description="optional comments")
+    final_video_watched: Literal["ended", "replayed"] | None = Field(
+        None, description="how the page saw the final attempt's video watched before it opened the questions: "
+        "played to its end, or replayed by the participant (None: not shown, or not said)")
+    final_video_seconds: float | None = Field(
+        None, ge=0, le=1e5, allow_inf_nan=False, description="seconds the final video played on screen")
     client_ts: float | None = _client_ts()
 
     @field_validator("rule")
@@ -306,18 +313,15 @@ def config_view(config: StudyConfig, study: StudyFile | None, manager: SessionMa
                 "rounds": next(iter(manager.conditions.values()))[0].budget,
                 "url_parameters": list(URL_PARAMETERS)}
     assigned = config.design == "assigned-rule"
+    # never the method, the condition or the rule's name: a participant could read them in the
+    # browser's tools (the rule's sentence, which an assigned-rule study shows anyway, is fine)
     return {
         "study": False,
         "consent": None,
         "require_pid": False,
         "url_parameters": list(URL_PARAMETERS),
-        "method": config.run.learner.method,
-        "signal": config.signal,
         "rounds": config.budget,
-        # assigned-rule: the rule participants are given (and are scored against);
-        # free-rule: every participant picks their own, nothing is scored
         "design": config.design,
-        "intention": config.intention_name,
         "intention_description": config.intention_description if assigned else None,
         "show_estimate": config.show_estimate,
         "fps": config.fps,
@@ -342,10 +346,28 @@ def add_session_routes(app: FastAPI, manager: SessionManager, guard: SessionLimi
         key, key_sha256 = new_session_key()
         session = guard.create(client, participant=body.participant, seed=body.seed, pid=body.pid,
                                study_id=body.study_id, prolific_session_id=body.prolific_session_id,
-                               consent=body.consent, key_sha256=key_sha256)
+                               consent=body.consent, key_sha256=key_sha256, start=body.start)
         response.set_cookie(KEY_COOKIE, key, max_age=KEY_COOKIE_MAX_AGE, path=f"/api/sessions/{session.id}",
                             httponly=True, samesite="strict", secure=request.url.scheme == "https")
         return session_state(session)
+
+    @app.post("/api/sessions/{sid}/start", summary="Start an enrolled session's episode (the page's Start)")
+    def start_session(session: Owned, request: Request) -> dict:
+        client = request.client.host if request.client else "unknown"
+        return session_state(guard.start(session, client))
+
+    @app.post("/api/sessions/{sid}/leave", status_code=204, response_class=Response,
+              summary="The session's page is closing (a beacon): cancelled unless a page of it comes back soon")
+    async def leave_session(sid: str, request: Request) -> Response:
+        # by hand, not the Owned dependency: a beacon's body is whatever the browser sends
+        session = manager.get(sid)
+        if session is None:
+            raise ApiError(404, "unknown_session", f"unknown session {sid[:40]!r}")
+        if not session.holds_key(key_cookies(request)):
+            raise ApiError(403, "not_session_owner", f"session {sid} can be left only by the browser that started it")
+        if session.active:
+            guard.leave(sid)
+        return Response(status_code=204)
 
     @app.get("/api/sessions/{sid}", summary="Session state: round i of K, the question, z, status")
     def get_session(sid: str) -> dict:
@@ -375,7 +397,9 @@ def add_session_routes(app: FastAPI, manager: SessionManager, guard: SessionLimi
               summary="The end-of-session questionnaire (once, after the final attempt)")
     def post_questionnaire(session: Owned, request: Request, body: QuestionnaireAnswers) -> dict:
         record = session.submit_questionnaire(body.model_dump(), by=answerer(session, request))
-        return {"saved": True, "questionnaire": record}
+        # the participant's own answers back, not the session's condition or rule (kept on disk)
+        own = ("final_attempt", "rule", "comments", "final_video_watched", "final_video_seconds", "submitted")
+        return {"saved": True, "questionnaire": {k: record.get(k) for k in own}}
 
     @app.get("/api/sessions/{sid}/result", summary="The episode's result (summary.json) once finished")
     def get_result(sid: str) -> dict:
@@ -421,7 +445,7 @@ def add_page_routes(app: FastAPI, signals: dict[str, Signal]) -> None:
 async def _sweep(guard: SessionLimits) -> None:
     """Cancel idle sessions now and then, so an abandoned tab frees its slot without waiting
     for the next new session to ask."""
-    every = max(1.0, min(30.0, guard.limits.idle_timeout / 4))
+    every = max(1.0, min(30.0, guard.limits.idle_timeout / 4, guard.limits.reconnect_grace / 2))
     while True:
         await asyncio.sleep(every)
         try:

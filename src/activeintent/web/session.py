@@ -56,7 +56,8 @@ def signal_page(signal: str) -> str:
     return f"/signal/{signal}"
 
 
-Status = Literal["waiting-for-learner", "waiting-for-answer", "finished", "failed", "cancelled"]
+# enrolled: agreed and given a key, the episode not started yet (it starts at the page's Start)
+Status = Literal["enrolled", "waiting-for-learner", "waiting-for-answer", "finished", "failed", "cancelled"]
 # (seed, out_dir, user, observers) -> Episode; the session is one of the episode's observers
 EpisodeBuilder = Callable[[int, Path, HumanUser, list[Any]], Any]
 
@@ -313,6 +314,8 @@ class WebSession:
         self._status_override: Status | None = None
         self._events_lock = threading.Lock()
         self._thread = threading.Thread(target=self._run, name=f"session-{sid}", daemon=True)
+        self.begun = False  # the episode runs (Start pressed); before: enrolled, holding no slot
+        self._start_lock = threading.Lock()
 
     # -- lifecycle --------------------------------------------------------------------------
     def _write_session_file(self) -> None:
@@ -338,6 +341,10 @@ class WebSession:
         })
 
     def start(self) -> None:
+        with self._start_lock:
+            if self.begun or self._done.is_set():
+                return
+            self.begun = True
         self._write_session_file()
         self.log_server("session_created", seed=self.seed, participant=self.participant,
                         design=self.config.design, show_estimate=self.config.show_estimate,
@@ -382,6 +389,13 @@ class WebSession:
             self._done.set()
 
     def cancel(self, reason: str) -> None:
+        with self._start_lock:
+            if not self.begun and not self._done.is_set():  # enrolled only: nothing runs
+                self.error = reason
+                self._status_override = "cancelled"
+                self.ended = time.time()
+                self._done.set()
+                return
         self.user.cancel(reason)
 
     def join(self, timeout: float | None = None) -> bool:
@@ -391,11 +405,19 @@ class WebSession:
     def status(self) -> Status:
         if self._status_override is not None:
             return self._status_override
+        if not self.begun:
+            return "enrolled"
         return "waiting-for-answer" if self.user.question is not None else "waiting-for-learner"
 
     @property
     def active(self) -> bool:
+        """Not ended yet (enrolled or running)."""
         return not self._done.is_set()
+
+    @property
+    def running(self) -> bool:
+        """Its episode runs: it holds a slot of the server's and its client's."""
+        return self.begun and not self._done.is_set()
 
     # -- the episode's hooks (worker thread) -----------------------------------------------
     def live_export(self, name: str) -> LiveExport | None:
@@ -575,11 +597,12 @@ class SessionManager:
 
     def create(self, participant: str | None = None, seed: int | None = None, pid: str | None = None,
                study_id: str | None = None, prolific_session_id: str | None = None,
-               consent: bool | None = None, key_sha256: str | None = None) -> WebSession:
-        """A new session, started. ``key_sha256``: the SHA-256 of the key the browser that asked
-        for it was given (:func:`new_session_key`); only requests carrying that key may answer."""
-        from activeintent.web.study import button_order
-
+               consent: bool | None = None, key_sha256: str | None = None, start: bool = True) -> WebSession:
+        """A new session. ``key_sha256``: the SHA-256 of the key the browser that asked for it
+        was given (:func:`new_session_key`); only requests carrying that key may answer.
+        ``start=False`` only enrols it (the start page's agreement): its condition is the one
+        the assignment would give now, but it is counted, given its seed and its episode
+        started only by :meth:`begin` (the page's Start)."""
         study = self.study
         if study is not None and study.require_pid and pid is None:
             raise ApiError(422, "pid_required", "this study needs a participant ID from its link "
@@ -588,29 +611,60 @@ class SessionManager:
             raise ApiError(422, "consent_required", "the session starts only after the participant "
                            "agrees to the consent text (consent: true)")
         with self._lock:
-            active = sum(1 for s in self._sessions.values() if s.active)
-            if active >= self.config.max_sessions:
-                raise AnswerRejected(
-                    f"{active} sessions are in progress (limit {self.config.max_sessions}); try again later",
-                    status=503,
-                )
-            got = self.assigner.assign(pid)
-            config, builder = self.conditions[got.condition]
-            if seed is None:
-                seed = config.run.protocol.seed + got.number  # persisted: a restarted server does not repeat seeds
+            if start:
+                self._check_room()
+            condition = self.assigner.peek(pid)
+            config, builder = self.conditions[condition]
             sid = secrets.token_hex(8)
             while sid in self._sessions or (self.config.out_dir / sid).exists():
                 sid = secrets.token_hex(8)
             enrolment = Enrolment(
-                **got.model_dump(), pid=pid, study_id=study_id, prolific_session_id=prolific_session_id,
+                condition=condition, pid=pid, study_id=study_id, prolific_session_id=prolific_session_id,
                 consented=time.time() if consent else None,
-                button_order=button_order(config.signal, got.slot, study.counterbalance_buttons if study else True),
                 key_id=key_sha256[:KEY_ID_CHARS] if key_sha256 else None)
             completion = Completion(code=study.completion_code, redirect_url=study.redirect_url,
                                     redirect_after_s=study.redirect_after_s) if study else None
-            session = WebSession(sid, seed, config, builder, participant if pid is None else pid,
+            session = WebSession(sid, -1 if seed is None else seed, config, builder,
+                                 participant if pid is None else pid,
                                  enrolment=enrolment, completion=completion, key_sha256=key_sha256)
+            session.seed_given = seed is not None
             self._sessions[sid] = session
+        if start:
+            self.begin(session)
+        return session
+
+    def _check_room(self) -> None:
+        running = sum(1 for s in self._sessions.values() if s.running)
+        if running >= self.config.max_sessions:
+            raise AnswerRejected(
+                f"{running} sessions are in progress (limit {self.config.max_sessions}); try again later",
+                status=503,
+            )
+
+    def begin(self, session: WebSession) -> WebSession:
+        """Start an enrolled session's episode: it is counted in its condition now (the one it
+        was told of), gets its seed and button order, and runs."""
+        from activeintent.web.study import button_order
+
+        study = self.study
+        with self._lock:
+            if session.begun or not session.active:
+                return session
+            self._check_room()
+            e = session.enrolment
+            got = self.assigner.assign(e.pid, condition=e.condition)
+            if got.condition != e.condition:  # a returning pid keeps its earlier condition
+                session.config, session.builder = self.conditions[got.condition]
+                session.user = HumanUser(session.config.signal, timeout=session.config.answer_timeout,
+                                         present=session._present)
+            config = session.config
+            if not getattr(session, "seed_given", False):
+                # persisted: a restarted server does not repeat seeds
+                session.seed = config.run.protocol.seed + got.number
+            session.enrolment = e.model_copy(update={
+                **got.model_dump(),
+                "button_order": button_order(config.signal, got.slot,
+                                             study.counterbalance_buttons if study else True)})
         session.start()
         return session
 

@@ -41,11 +41,10 @@ def session_state(session: WebSession) -> dict:
     submitted = session.questionnaire.submitted
     return {
         "id": session.id,
-        "method": config.run.learner.method,
-        "signal": config.signal,
+        # never the method, the condition or the rule's name (a participant could read them in
+        # the browser's tools); the page's path is the signal's, which the page shows anyway
         "page": signal_page(config.signal),
         "design": config.design,
-        "intention": config.intention_name,
         "intention_description": config.intention_description,
         "show_estimate": config.show_estimate,
         "status": status,

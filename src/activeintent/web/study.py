@@ -178,12 +178,23 @@ class Assigner:
         write_json(self.path, {"counts": self.counts, "tie_order": self.tie_order, "total": self.total,
                                "participants": self.participants})
 
-    def assign(self, pid: str | None = None) -> Assignment:
+    def peek(self, pid: str | None = None) -> str:
+        """The condition :meth:`assign` would give now, counting nothing (a participant who has
+        agreed but not pressed Start yet holds no place in the counts)."""
+        with self._lock:
+            if pid is not None and pid in self.participants:
+                return self.participants[pid]["condition"]
+            return min(self.tie_order, key=lambda c: (self.counts[c], self.tie_order.index(c)))
+
+    def assign(self, pid: str | None = None, condition: str | None = None) -> Assignment:
+        """Count a participant in: a participant ID seen before gets its earlier condition;
+        else ``condition`` (the one :meth:`peek` told them of) or the least filled one."""
         with self._lock:
             if pid is not None and pid in self.participants:
                 return Assignment(**self.participants[pid], again=True)
             # least filled first; among equals, the seeded order
-            name = min(self.tie_order, key=lambda c: (self.counts[c], self.tie_order.index(c)))
+            name = condition if condition in self.counts else min(
+                self.tie_order, key=lambda c: (self.counts[c], self.tie_order.index(c)))
             got = Assignment(condition=name, slot=self.counts[name], number=self.total)
             self.counts[name] += 1
             self.total += 1

@@ -44,7 +44,7 @@
       Study.setWaiting(true, "Thank you. The robot is thinking about what to show you next…");
     } catch (err) {
       Study.log("answer_rejected", { choice, error: err.message }, answering);
-      status.textContent = `Not accepted: ${err.message}`;
+      status.textContent = Study.friendly(err, "Your answer could not be saved. Please try again.");
       round = answering;
       setEnabled(true);
     }

@@ -65,7 +65,8 @@
     try {
       await Study.reportVideo(round, "replay", 0); // before any stop of the replay can be sent
     } catch (err) {
-      status.textContent = `Replay not possible: ${err.message}`;
+      Study.log("replay_refused", { error: err.message, code: err.code ?? null }, shownRound);
+      status.textContent = Study.friendly(err, "The video cannot be replayed now. Please choose an answer.");
       replayBtn.disabled = false;
       return;
     }
@@ -98,7 +99,7 @@
 
   function setEnabled(on) {
     stopBtn.disabled = !(on && (phase === "first" || phase === "replay"));
-    newBtn.disabled = !on;
+    newBtn.disabled = !(on && phase !== "gate"); // not before the participant has seen the table
     goodBtn.disabled = !(on && phase === "ended");
   }
 
@@ -130,7 +131,7 @@
       replayBtn.classList.add("hidden");
       if (action === "stop") {
         markStop(body.time);
-        status.textContent = `You stopped the robot at ${body.time.toFixed(2)} s: the frame stays above.`;
+        status.textContent = `You stopped the robot at ${body.time.toFixed(2)} s.`;
         Study.setWaiting(true, "Thank you. The robot is thinking about what you showed it…", true);
       } else {
         status.textContent = "";
@@ -138,7 +139,7 @@
       }
     } catch (err) {
       Study.log("answer_rejected", { action, error: err.message, code: err.code ?? null }, answering);
-      status.textContent = `Not accepted: ${err.message}`;
+      status.textContent = Study.friendly(err, "Your answer could not be saved. Please try again.");
       round = answering;
       setEnabled(true);
     }
@@ -196,6 +197,7 @@
     Study.orderButtons(document.getElementById("answers"), "data-action", s.button_order);
     if (s.status === "waiting-for-answer" && s.question && s.question.round !== shownRound) {
       shownRound = s.question.round;
+      status.textContent = ""; // the last round's words do not outlive its frame
       Study.betweenRounds(s, () => show(s.question));
     } else if (s.status === "waiting-for-learner") {
       round = null;

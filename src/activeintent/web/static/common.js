@@ -56,7 +56,12 @@ const Study = (() => {
   }
 
   setInterval(flush, 1000);
-  addEventListener("pagehide", flushNow);
+  addEventListener("pagehide", () => {
+    flushNow();
+    // the page is going away (closed, reloaded or the next page): unless a page of this session
+    // asks again within the server's reconnect grace, the session ends and frees its slot
+    if (sessionId) navigator.sendBeacon(`/api/sessions/${sessionId}/leave`);
+  });
   document.addEventListener("visibilitychange", () => log("visibility", { state: document.visibilityState }));
 
   function goTo(page) {
@@ -76,7 +81,8 @@ const Study = (() => {
           onState(s);
         }
       } catch (err) {
-        showFatal(err.status === 404 ? "This session does not exist (or the server was restarted)." : `Lost contact with the server: ${err.message}`);
+        log("poll_failed", { status: err.status ?? null, code: err.code ?? null });
+        showFatal(err.status === 404 ? friendly(err) : "Lost contact with the study server; trying again…");
         if (err.status === 404) return;
       }
       setTimeout(tick, interval);
@@ -203,6 +209,29 @@ const Study = (() => {
     captionEl.textContent = `${label}.${length} Objects on the table: ${names || "none"}.`;
   }
 
+  // What a participant reads when a request fails: never the server's own sentence (that one
+  // goes to the log), but what happened and what to do, in the participant's terms.
+  const MESSAGES = {
+    too_many_sessions: "This computer already has a study session open (perhaps in another tab or window). " +
+      "Please finish or close it; if you closed it, wait a minute and try again.",
+    session_rate_limited: "Too many sessions were started from this computer in the last hour. " +
+      "Please try again later, or contact the researchers.",
+    server_full: "The study is full at the moment. Please try again in a few minutes.",
+    server_busy: "The study server is busy at the moment. Please try again in a few minutes.",
+    pid_required: "This link has no participant ID. Please open the link you were given.",
+    consent_required: "The study starts only once you agree to take part.",
+    not_session_owner: "This session was started in another browser or tab, or your cookies were cleared. " +
+      "Please open the study link again to start afresh.",
+    unknown_session: "This session does not exist any more (the server may have been restarted). " +
+      "Please open the study link again.",
+    after_video_end: "The video had already ended, so that Stop did not count. Choose another answer, or replay the video.",
+  };
+  function friendly(err, fallback = "Something went wrong. Please try again; if it keeps happening, contact the researchers.") {
+    if (err && err.code && MESSAGES[err.code]) return MESSAGES[err.code];
+    if (err && err.status === undefined) return "The study server cannot be reached. Please check your connection and try again.";
+    return fallback;
+  }
+
   function showFatal(msg) {
     const el = document.getElementById("status");
     if (el) { el.textContent = msg; el.classList.add("error"); }
@@ -215,12 +244,27 @@ const Study = (() => {
       if (!video.videoWidth) return;
       document.documentElement.style.setProperty("--video-width", `${video.videoWidth}px`);
       document.documentElement.style.setProperty("--video-aspect", `${video.videoWidth} / ${video.videoHeight}`);
+      document.documentElement.style.setProperty("--video-ratio", String(video.videoWidth / video.videoHeight));
     });
     // "waiting": playback paused for frames not yet drawn (videos are shown while they are drawn)
     for (const type of ["loadedmetadata", "play", "playing", "waiting", "pause", "seeked", "ended", "error"]) {
       video.addEventListener(type, () =>
         log(`video_${type}`, { video: label, time: video.currentTime, duration: video.duration }, roundOf()));
     }
+    // A stall: from "waiting" until frames flow again ("playing"), or until the round's answer
+    // ends it (video_stall_open); one video_stall event each, with its length (export: per round).
+    let stalled = null;
+    video.addEventListener("waiting", () => {
+      if (stalled === null) stalled = { at: video.currentTime, since: now(), round: roundOf() };
+    });
+    const endStall = (how) => {
+      if (stalled === null) return;
+      const s = stalled;
+      stalled = null;
+      log("video_stall", { video: label, at: s.at, seconds: Math.round((now() - s.since) * 1000) / 1000, how }, s.round);
+    };
+    video.addEventListener("playing", () => endStall("resumed"));
+    video.addEventListener("emptied", () => endStall("replaced")); // the next round's video
   }
 
   // Play a video again from its start. A video sent while it was still being drawn cannot be
@@ -294,6 +338,6 @@ const Study = (() => {
   return {
     sessionId, now, api, log, flush, goTo, poll, setProgress, fillGuess, setEstimate, setWaiting, showFatal,
     watchVideo, routeFinished, isTyping, setupLegend, fillLegend, describeVideo, betweenRounds,
-    readyGate, reportVideo, orderButtons, restart,
+    readyGate, reportVideo, orderButtons, restart, friendly,
   };
 })();

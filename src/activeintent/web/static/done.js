@@ -12,12 +12,46 @@
 
   Study.watchVideo(video, "final", () => null);
   Study.setupLegend(document.getElementById("legend-toggle"), document.getElementById("legend"), () => null);
-  document.getElementById("replay").addEventListener("click", () => {
+  const replayBtn = document.getElementById("replay");
+
+  // The questions open only once the final attempt has played to its end (a reload keeps that);
+  // what is sent with the answers: whether it was watched to the end or also replayed, and the
+  // seconds it played on screen.
+  const WATCH_KEY = `activeintent.finalWatched.${Study.sessionId}`;
+  const watch = (() => {
+    try { return JSON.parse(sessionStorage.getItem(WATCH_KEY)) || { ended: false, replays: 0, seconds: 0 }; }
+    catch (_) { return { ended: false, replays: 0, seconds: 0 }; }
+  })();
+  const keepWatch = () => { try { sessionStorage.setItem(WATCH_KEY, JSON.stringify(watch)); } catch (_) { /* private mode */ } };
+  let lastTime = null;
+  video.addEventListener("timeupdate", () => {
+    const t = video.currentTime;
+    if (!video.paused && lastTime !== null && t > lastTime) watch.seconds += Math.min(t - lastTime, 1);
+    lastTime = t;
+  });
+  video.addEventListener("seeking", () => { lastTime = null; });
+  video.addEventListener("ended", () => {
+    lastTime = null;
+    if (!watch.ended) Study.log("final_watched", { seconds: watch.seconds });
+    watch.ended = true;
+    keepWatch();
+    replayBtn.classList.remove("hidden");
+    setLocked(false);
+  });
+  replayBtn.addEventListener("click", () => {
     if (document.getElementById("stage").classList.contains("gated")) return;
+    watch.replays += 1;
+    keepWatch();
     Study.log("replay", { video: "final" });
+    lastTime = null;
     video.currentTime = 0;
     video.play().catch(() => {});
   });
+  function setLocked(locked) {
+    form.dataset.locked = String(locked);
+    document.getElementById("q-locked").classList.toggle("hidden", !locked);
+    for (const el of form.querySelectorAll("input, textarea, button")) el.disabled = locked;
+  }
 
   let redirecting = false;
   function finish(s) {
@@ -76,6 +110,10 @@
     }
     const body = { rule, client_ts: Study.now() };
     if (asks) body.final_attempt = picked.value;
+    if (state.final_video && watch.ended) {
+      body.final_video_watched = watch.replays > 0 ? "replayed" : "ended";
+      body.final_video_seconds = Math.round(watch.seconds * 100) / 100;
+    }
     if (comments) body.comments = comments;
     submit.disabled = true;
     qStatus.classList.remove("error");
@@ -87,7 +125,7 @@
     } catch (err) {
       if (err.code === "already_submitted") { finish(state); return; }
       Study.log("questionnaire_rejected", { error: err.message });
-      qStatus.textContent = `Not saved: ${err.message}`;
+      qStatus.textContent = Study.friendly(err, "Your answers could not be saved. Please check them and try again.");
       qStatus.classList.add("error");
       submit.disabled = false;
     }
@@ -121,6 +159,8 @@
         "The robot's final attempt on a new table", s.final_legend, s.final_video.duration);
       video.src = s.final_video.url;
       document.getElementById("stage").classList.add("gated");
+      replayBtn.classList.toggle("hidden", !watch.ended);
+      setLocked(!watch.ended);
       Study.readyGate(document.getElementById("gate"), null, () => {
         document.getElementById("stage").classList.remove("gated");
         video.play().catch(() => {});

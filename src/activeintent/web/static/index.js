@@ -1,7 +1,8 @@
 // Start page. Step 1 (no session yet): the consent text of the study file and the participant
 // ID from the link (?pid= or Prolific's PROLIFIC_PID, STUDY_ID, SESSION_ID), or a typed code.
-// Agreeing creates the session and reloads as /?session=…, step 2: what to do, for the
-// condition this participant was assigned (which only the session knows).
+// Agreeing enrols the participant (a session that does not run yet, with its key) and reloads
+// as /?session=…, step 2: what to do, for the condition this participant will get. Only Start
+// starts the session's episode (and takes one of the server's slots).
 "use strict";
 
 (async () => {
@@ -15,7 +16,7 @@
   try {
     config = await Study.api("GET", "/api/config");
   } catch (err) {
-    Study.showFatal(`The study server does not answer: ${err.message}`);
+    Study.showFatal("The study server cannot be reached. Please check your connection and reload this page.");
     return;
   }
   $("step-enter").classList.remove("hidden");
@@ -28,10 +29,16 @@
       "digits, '_' or '-'). Please open the link you were given again, or contact the researchers.");
     return;
   }
-  if (config.require_pid && pid === null) {
-    Study.showFatal("This link has no participant ID (?pid=… or ?PROLIFIC_PID=…). Please open the link you were given.");
-    return;
+  // A study that needs a participant ID and a link without one: the participant types it
+  // (checked as the link's would be); otherwise the code field is optional free text.
+  const typedPid = config.require_pid && pid === null;
+  const field = $("participant");
+  if (typedPid) {
+    $("participant-label").textContent = "Your participant ID (required)";
+    field.maxLength = 64;
+    field.setAttribute("aria-required", "true");
   }
+  const typedOk = () => !typedPid || ID_PATTERN.test(field.value.trim());
   if (pid !== null) {
     $("pid-value").textContent = pid;
     $("pid-line").classList.remove("hidden");
@@ -53,19 +60,31 @@
       $("declined").classList.remove("hidden");
     });
   }
-  begin.disabled = false;
+  begin.disabled = !typedOk();
+  field.addEventListener("input", () => {
+    begin.disabled = !typedOk();
+    $("status").textContent = typedPid && field.value.trim() && !typedOk()
+      ? "A participant ID has 1 to 64 letters, digits, '_' or '-'." : "";
+    $("status").classList.remove("error");
+  });
+  field.addEventListener("keydown", (e) => {
+    if (e.key === "Enter" && !begin.disabled) begin.click();
+  });
   begin.addEventListener("click", async () => {
+    if (!typedOk()) return;
     begin.disabled = true;
     $("status").textContent = "Starting…";
     const body = {};
     for (const [k, v] of Object.entries(ids)) if (v !== null) body[k] = v;
-    if (pid === null) body.participant = $("participant").value.trim() || null;
+    if (typedPid) body.pid = field.value.trim();
+    else if (pid === null) body.participant = field.value.trim() || null;
     if (config.consent) body.consent = true;
+    body.start = false; // the episode starts at Start, not here
     try {
       const s = await Study.api("POST", "/api/sessions", body);
       location.href = `/?session=${encodeURIComponent(s.id)}`;
     } catch (err) {
-      Study.showFatal(err.message);
+      Study.showFatal(Study.friendly(err));
       begin.disabled = false;
     }
   });
@@ -75,10 +94,10 @@
     try {
       s = await Study.api("GET", `/api/sessions/${Study.sessionId}`);
     } catch (err) {
-      Study.showFatal(err.status === 404 ? "This session does not exist (or the server was restarted)." : err.message);
+      Study.showFatal(Study.friendly(err));
       return;
     }
-    if (s.status !== "waiting-for-learner" && s.status !== "waiting-for-answer") return Study.goTo("/done");
+    if (!["enrolled", "waiting-for-learner", "waiting-for-answer"].includes(s.status)) return Study.goTo("/done");
     $("step-how").classList.remove("hidden");
     // the signal's own instructions (a fragment from the signal's folder, as trusted as its page)
     const how = await fetch(`${s.page}/how`, { cache: "no-store" });
@@ -101,9 +120,20 @@
     Study.poll(() => {}); // keeps the session from going idle while the participant reads
     const start = $("start");
     start.disabled = false;
-    start.addEventListener("click", () => {
+    start.addEventListener("click", async () => {
       Study.log("start_clicked");
-      Study.goTo(s.page);
+      start.disabled = true;
+      $("status-how").textContent = "Starting…";
+      $("status-how").classList.remove("error");
+      try {
+        if (s.status === "enrolled") await Study.api("POST", `/api/sessions/${Study.sessionId}/start`);
+        Study.goTo(s.page);
+      } catch (err) {
+        Study.log("start_refused", { status: err.status ?? null, code: err.code ?? null });
+        $("status-how").textContent = Study.friendly(err);
+        $("status-how").classList.add("error");
+        start.disabled = false;
+      }
     });
   }
 })();
