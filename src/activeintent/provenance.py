@@ -15,7 +15,7 @@ from importlib import metadata
 from pathlib import Path
 
 # Results folders and scratch runs are written inside the checkout: they do not make it "dirty".
-_NOT_CODE = (":(exclude)docs/results", ":(exclude)runs")
+_NOT_CODE = (":(exclude)docs/results", ":(exclude)runs", ":(exclude,glob)experiments/*/results/**")
 _BLAS_ENV = ("OPENBLAS_CORETYPE", "OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
 

@@ -158,6 +158,8 @@ def count(goals: Iterable[Goal]) -> dict[str, dict[str, int]]:
 
 
 def fit(goals: list[Goal], alpha: float, corpus: str = "") -> FittedPrior:
+    if not alpha > 0:
+        raise ValueError(f"the smoothing strength must be > 0 (got {alpha}): a goal nobody asked for stays possible")
     return FittedPrior(count(goals), alpha, corpus, len(goals))
 
 
