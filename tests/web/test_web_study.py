@@ -273,3 +273,24 @@ def test_assigned_rule_is_shown_scored_and_exported_with_hidden_guesses(live_ser
     assert [r["answer"] for r in row["rounds"]] == ["B"] and row["rounds"][0]["response_s"] >= 0
     assert row["questionnaire_final_attempt"] == "no" and row["questionnaire_rule"] == "same colours"
     assert row["status"] == "finished" and row["show_estimate"] == "hidden"
+
+
+def test_the_corpus_export_keeps_free_rule_words_and_leaves_assigned_rules_out(tmp_path):
+    """study-export --corpus: a lab fits its population's prior on a pilot's own words; an
+    assigned-rule participant paraphrases the rule given, so those never enter it."""
+    from activeintent.goals.prior import PriorError, read_corpus
+
+    out = tmp_path / "study"
+    _fake_session(out, "a" * 16, 1000.0, "assigned-rule", "color-match",
+                  {"final_attempt": "yes", "rule": "blocks in the bowl of their colour"})
+    _fake_session(out, "b" * 16, 2000.0, "free-rule", None, {"final_attempt": "yes", "rule": "  tall towers please "})
+    _fake_session(out, "c" * 16, 3000.0, "free-rule", None, {"final_attempt": "no", "rule": ""})
+    corpus = tmp_path / "corpus.jsonl"
+    res = CliRunner().invoke(app, ["study-export", str(out), "--to", str(tmp_path / "s.csv"), "--corpus", str(corpus)])
+    assert res.exit_code == 0, res.output
+    rows = [json.loads(x) for x in corpus.read_text().splitlines()]
+    assert [r["request"] for r in rows] == ["tall towers please"]  # the free-rule answer, as typed
+    assert rows[0]["id"] == "b" * 16 and rows[0]["goal"] is None and rows[0]["writer"]
+    assert "colour" not in corpus.read_text()  # the assigned rule never leaks in
+    with pytest.raises(PriorError, match="no translated request"):  # untranslated: nothing to fit yet
+        read_corpus(corpus)

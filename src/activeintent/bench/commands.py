@@ -239,6 +239,9 @@ def coverage(
     after_freeze: Annotated[bool, typer.Option("--after-freeze", help="Also print held-out intentions one by one (only after a freeze commit: docs/protocol.md)")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="print JSON")] = False,
     out: Annotated[Path | None, typer.Option("--out", help="Also write the table as JSON here")] = None,
+    goal: Annotated[str | None, typer.Option("--goal", help="Score this goal of the language against each intention "
+                                             "both ways (its plan satisfies the intention; the intention's plan "
+                                             "satisfies it) instead of searching for the best goal")] = None,
 ) -> None:
     """How well the goal language can say each intention: its best goal by behaviour (the goal
     whose own plan satisfies the intention on most test scenes), that plan's success — the
@@ -269,6 +272,27 @@ def coverage(
         console.print(f"[red]error:[/red] {err}")
         raise typer.Exit(2) from None
     groups = [suite_of(n) for n in names] + ["file"] * len(intention_file or [])
+    if goal is not None:
+        from activeintent.bench.coverage import agreement
+        from activeintent.goals.language import parse_goal
+
+        if any(g in HELDOUT_SUITES for g in groups) and not after_freeze:
+            console.print("[red]error:[/red] held-out intentions are read only after a freeze (--after-freeze)")
+            raise typer.Exit(2)
+        try:
+            z = parse_goal(goal)
+        except (ValueError, IndexError, KeyError) as err:
+            console.print(f"[red]error:[/red] --goal {escape(goal)!s}: not a goal of the language ({escape(str(err))})")
+            raise typer.Exit(2) from None
+        rows_ = [agreement(z, it, test_scenes, seed) for it in items]
+        if as_json:
+            typer.echo(json.dumps(rows_, indent=2, ensure_ascii=False))
+            return
+        for r in rows_:
+            console.print(f"{escape(r['intention'])}: the goal's plan satisfies it on {r['goal_plan_satisfies_checker']:.2f}, "
+                          f"its plan satisfies the goal on {r['checker_plan_satisfies_goal']:.2f} of {r['scenes']} "
+                          f"feasible test scenes", highlight=False)
+        return
     table = coverage_table(items, groups, seed=seed, scenes=scenes, test_scenes=test_scenes,
                            progress=lambda text: print_line(console, escape(text)) if not as_json else None)
     if not after_freeze:  # per-intention rows of a held-out suite are the reading its rule forbids

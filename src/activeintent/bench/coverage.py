@@ -121,6 +121,21 @@ def goal_success(goal: Goal, scenes: list[tuple[Scene, int]], intention: Intenti
     return hits / max(len(scenes), 1), finals
 
 
+def agreement(goal: Goal, intention: Intention, n: int = TEST_SCENES, seed: int = 0) -> dict:
+    """A given goal against a checker, both ways, on ``n`` test scenes where the checker is
+    feasible: the share where the goal's plan satisfies the checker, and the share where the
+    checker's own plan satisfies the goal (a goal or checker with no plan there fails)."""
+    scenes = feasible_scenes(intention, n, seed, "agreement")
+    forward, _ = goal_success(goal, scenes, intention)
+    hits = 0
+    for scene, layout_seed in scenes:
+        s0 = WorldState(positions=layout(scene, layout_seed))
+        steps = intention.plan(s0)
+        hits += steps is not None and goal.holds(facts(run_plan(s0, steps)))
+    return {"goal": goal.key, "intention": intention.name, "scenes": len(scenes),
+            "goal_plan_satisfies_checker": round(forward, 4), "checker_plan_satisfies_goal": round(hits / len(scenes), 4)}
+
+
 def _bank(intention: Intention, scenes: list[tuple[Scene, int]], rng: np.random.Generator) -> list[Trial]:
     trials = []
     for scene, seed in scenes:

@@ -176,6 +176,7 @@ def serve(
 def study_export(
     out_dir: Annotated[Path, typer.Argument(help="The --out folder of `activeintent serve` (one sub-folder per session)")],
     to: Annotated[Path, typer.Option("--to", help="The table to write: FILE.csv (one row per session) or FILE.jsonl (one object per session)")],
+    corpus: Annotated[Path | None, typer.Option("--corpus", help="Also write the free-rule sessions' rules in their own words as a corpus of requests (JSON lines, data/requests' format; translate each into a goal, then `prior fit`)")] = None,
 ) -> None:
     """One table of a study: per session the participant code, design, rule, answers per round,
     timings, success (assigned-rule sessions only) and the questionnaire."""
@@ -189,6 +190,18 @@ def study_export(
         raise typer.BadParameter(f"{to.name}: the table is written as .csv or .jsonl", param_hint="--to")
     sessions, skipped = collect_sessions(out_dir)
     write_table(sessions, to)
+    if corpus is not None:
+        import json
+        import os
+
+        from activeintent.web.export import corpus_rows
+
+        rows = corpus_rows(sessions)
+        corpus.parent.mkdir(parents=True, exist_ok=True)
+        tmp = corpus.with_name(f".{corpus.name}.{os.getpid()}.tmp")
+        tmp.write_text("".join(json.dumps(r, ensure_ascii=False) + "\n" for r in rows))
+        os.replace(tmp, corpus)
+        Console().print(f"{len(rows)} free-rule rules written to {corpus} (assigned-rule sessions left out)")
     console = Console(stderr=True)
     for folder, why in skipped:
         console.print(f"[yellow]skipped {folder.name}[/]: {why}")

@@ -197,6 +197,22 @@ def session_record(folder: Path) -> dict:
     }
 
 
+def corpus_rows(records: list[dict]) -> list[dict]:
+    """The "your rule in your words" answers of free-rule sessions, in the corpus format of
+    data/requests (``request``, ``writer`` = the participant code, ``date``; ``goal`` null until
+    someone translates it into the goal language, as `prior fit` reads). Assigned-rule sessions
+    are left out: their participants paraphrase the rule they were given."""
+    out = []
+    for r in records:
+        words = (r.get("questionnaire_rule") or "").strip()
+        if r.get("design") != "free-rule" or not words:
+            continue
+        date = (r.get("questionnaire_submitted") or r.get("ended") or "")[:10] or None
+        out.append({"id": r["session"], "request": words, "writer": r.get("participant") or r["session"],
+                    "date": date, "goal": None})
+    return out
+
+
 def collect_sessions(out_dir: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
     """The records of every session folder in ``out_dir`` (oldest first) and the folders
     skipped, with why."""

@@ -1,0 +1,71 @@
+"""The translation check: each sampled translation scored against an independent checker.
+
+    .venv/bin/python data/requests/check_translations.py [--scenes 100] [--jobs 2]
+
+For the 40 translated requests of check_sample.json: the translator's goal against the checker a
+second writer wrote from the request alone (checkers/*.py, class R<id>), both ways on test
+scenes where the checker is feasible (`coverage --goal`); they agree when both shares are
+≥ 0.9. For the 20 marked "not expressible": the language's best goal for the checker
+(`coverage`), confirmed when its plan success is < 0.8. Writes check_results.json beside this file.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+AGREE = 0.9
+
+
+def _checker(rid: str):
+    from activeintent.intentions.registry import load_intention_file
+
+    name = "R" + rid[1:]
+    for path in sorted((HERE / "checkers").glob("*.py")):
+        if f"class {name}(" in path.read_text():
+            return load_intention_file(f"{path}:{name}")
+    raise SystemExit(f"no checker class {name} in {HERE / 'checkers'}")
+
+
+def _translated(args: tuple[str, str, int]) -> dict:
+    from activeintent.bench.coverage import agreement
+    from activeintent.goals.language import parse_goal
+
+    rid, key, scenes = args
+    row = agreement(parse_goal(key), _checker(rid), scenes)
+    both = min(row["goal_plan_satisfies_checker"], row["checker_plan_satisfies_goal"])
+    return {"id": rid, **row, "agree": both >= AGREE}
+
+
+def _not_expressible(args: tuple[str, int]) -> dict:
+    from activeintent.bench.coverage import EXPRESSIBLE, coverage
+
+    rid, scenes = args
+    row = coverage(_checker(rid), test_scenes=scenes)
+    return {"id": rid, "best_goal": row.goal, "best_success": row.success, "confirmed": row.success < EXPRESSIBLE}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--scenes", type=int, default=100)
+    ap.add_argument("--jobs", type=int, default=2)
+    args = ap.parse_args()
+    sample = json.loads((HERE / "check_sample.json").read_text())
+    goals = {r["id"]: r["goal"] for r in map(json.loads, (HERE / "translations.jsonl").read_text().splitlines())}
+    with multiprocessing.get_context("spawn").Pool(args.jobs) as pool:
+        translated = pool.map(_translated, [(i, goals[i], args.scenes) for i in sample["translated"]])
+        marked = pool.map(_not_expressible, [(i, args.scenes) for i in sample["not_expressible"]])
+    agree = sum(r["agree"] for r in translated)
+    confirmed = sum(r["confirmed"] for r in marked)
+    out = {"agree": agree, "translated": len(translated), "confirmed": confirmed, "not_expressible": len(marked),
+           "threshold": AGREE, "scenes": args.scenes, "translated_rows": translated, "not_expressible_rows": marked}
+    (HERE / "check_results.json").write_text(json.dumps(out, indent=1) + "\n")
+    print(f"translations: {agree} of {len(translated)} agree ≥ {AGREE} both ways; "
+          f"not expressible: {confirmed} of {len(marked)} confirmed (best goal < 0.8)")
+
+
+if __name__ == "__main__":
+    main()
