@@ -43,7 +43,7 @@ def test_documented_command_validates(doc, command, tmp_path):
     args = shlex.split(command)[1:]
     env = {**os.environ, "ACTIVEINTENT_CHECK_ONLY": "1"}
     # A newcomer's checkout: the repository's folders, plus an (empty) study folder to export.
-    for name in ("examples", "docs", "src"):
+    for name in ("examples", "experiments", "data", "docs", "src"):
         (tmp_path / name).symlink_to(ROOT / name)
     (tmp_path / "runs" / "study").mkdir(parents=True)
     res = subprocess.run([sys.executable, "-m", "activeintent.cli", *args], cwd=tmp_path, env=env,

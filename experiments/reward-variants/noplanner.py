@@ -8,12 +8,25 @@ learners on their prior (docs/reward.md).
 """
 
 from activeintent.learners.registry import METHODS, LearnerContext, Method
-from activeintent.learners.reward.learner import RewardConfig, RewardLearner
+from activeintent.learners.reward.learner import RewardLearner
+
+
+class NoPlannerRewardLearner(RewardLearner):
+    """The peer whose candidates leave out the Bayesian planner's plans."""
+
+    uses_planner = False
+
+    def __init__(self, signal: str, rng=None):
+        super().__init__(signal, rng)
+        self.name = f"reward-{signal}-noplanner"
+
+    def planner_candidates(self, pool, rng, limit: int, prefixes: bool) -> None:
+        return None
 
 
 def _noplanner(signal: str) -> Method:
     def build(ctx: LearnerContext) -> RewardLearner:
-        return RewardLearner(signal, rng=ctx.learner_seed, config=RewardConfig(planner=False))
+        return NoPlannerRewardLearner(signal, rng=ctx.learner_seed)
 
     return Method(signal, False, build, f"ablation of reward-{signal}: candidates without the Bayesian planner", "peer")
 

@@ -28,9 +28,16 @@ SUBSET = tuple(FEATURE_NAMES.index(n) for n in (
     "all:part-of-row", "all:region[middle]"))
 
 
+class _WithoutPlanner(RewardLearner):
+    """Candidates from the features alone: what these tests learn comes from w · φ only."""
+
+    def planner_candidates(self, pool, rng, limit, prefixes):
+        return None
+
+
 def small_learner(seed: int = 0, prior: str = "uniform") -> RewardLearner:
-    return RewardLearner("preference", rng=seed, config=RewardConfig(
-        planner=False, n_scenes=1, features=SUBSET, particles=512, prior=prior))
+    return _WithoutPlanner("preference", rng=seed, config=RewardConfig(
+        n_scenes=1, features=SUBSET, particles=512, prior=prior))
 
 
 def exact_answer(w_true: np.ndarray, trajectories) -> str:

@@ -31,7 +31,9 @@ def register(app: typer.Typer) -> None:
 def serve(
     host: Annotated[str, typer.Option("--host", help="Address to bind (loopback unless told otherwise)")] = "127.0.0.1",
     port: Annotated[int, typer.Option("--port", min=0, max=65535, help="TCP port")] = 8000,
-    method: Annotated[str | None, typer.Option("--method", help="preference | mllm | mllm-llm | bayes-preference | bayes-stop (default bayes-preference; with --study: the study file's conditions)")] = None,
+    method: Annotated[str | None, typer.Option("--method", help="preference | mllm | mllm-llm | bayes-preference | bayes-stop | lang-preference | lang-stop (default bayes-preference; with --study: the study file's conditions)")] = None,
+    prior: opt.Prior = D.prior,
+    scenes: opt.Scenes = D.scenes,
     rounds: opt.Budget = D.budget,
     intention: Annotated[str | None, typer.Option("--intention", help="Assign this rule to every participant (shown on the start page; success is scored against it). Without it each participant picks their own rule and success is not scored (free-rule design)")] = None,
     intention_file: Annotated[str | None, typer.Option("--intention-file", help="Assign your own rule: path.py:NAME (as --intention)")] = None,
@@ -79,7 +81,7 @@ def serve(
     from activeintent.web.study import StudyFileError, load_study
 
     size = tuple(video_size)  # parsed by the option
-    extra = dict(vlm=vlm, base_url=base_url, cache=cache,
+    extra = dict(prior=prior, scenes=scenes, vlm=vlm, base_url=base_url, cache=cache,
                  cache_mode=cache_mode, executor=executor, retriever=retriever, plugins=list(plugin or []))
     study_file = None
     if study is not None:

@@ -4,7 +4,8 @@
 - ``feature_plans``: for each feature the scene can change, the greedy plan (≤ 2 steps) that
   raises it most, preferring moves that change fewer other features;
 - ``planner_plans``: the project's candidate planner (``learners.bayes.candidates``) run on
-  the hypothesis prior alone — no answer ever reaches it (switchable: ``planner=False``);
+  the hypothesis prior alone — no answer ever reaches it (experiments/reward-variants/noplanner.py
+  leaves them out);
 - ``reward_plans``: greedy hill-climbing on a reward vector (the posterior mean), for the
   final answer.
 """

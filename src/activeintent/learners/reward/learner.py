@@ -8,7 +8,7 @@ and w over candidate plans (``candidates.py``); the final answer on a test scene
 candidate plan whose predicted outcome has the largest posterior expected reward E[w] · φ.
 The learner never sees the hidden intention, its scene sampler or feasibility, or the user's
 parameters; the hypothesis prior of the Bayesian learners is used only to propose plans
-(``planner=True``, switchable for the ablation).
+(experiments/reward-variants/noplanner.py measures the peer without them).
 """
 
 from __future__ import annotations
@@ -43,7 +43,6 @@ from activeintent.world.trajectory import Trajectory
 class RewardConfig(BaseModel):
     """Settings of the reward learners (none tuned to particular intentions)."""
 
-    planner: bool = Field(True, description="also propose the Bayesian learners' plans on their prior alone")
     n_scenes: int = Field(3, ge=1, description="candidate scenes scored per design_scene")
     n_random: int = Field(12, ge=0, description="random skill sequences per scene")
     feature_depth: int = Field(2, ge=0, description="steps of the greedy one-feature plans (0: none)")
@@ -75,7 +74,7 @@ class RewardLearner(Learner):
             raise ValueError(f"reward learners read preference or stop; got {signal!r}")
         self.signal = signal
         self.config = c = config or RewardConfig()
-        self.name = f"reward-{signal}" + ("" if c.planner else "-noplanner") + ("" if c.prior == "uniform" else f"-{c.prior}")
+        self.name = f"reward-{signal}" + ("" if c.prior == "uniform" else f"-{c.prior}")
         self.rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng or 0)
         self.idx = np.arange(len(FEATURE_NAMES)) if c.features is None else np.array(c.features, int)
         self.names = [FEATURE_NAMES[i] for i in self.idx]
@@ -108,11 +107,16 @@ class RewardLearner(Learner):
 
     # ---- candidates ----
 
+    uses_planner = True  # the peer's candidates include the Bayesian planner's plans on its prior
+
+    def planner_candidates(self, pool, rng: np.random.Generator, limit: int, prefixes: bool) -> None:
+        """The Bayesian learners' plans on their prior alone join the candidates."""
+        cand.planner_plans(pool, rng, limit=limit, prefixes=prefixes)
+
     def candidates(self, state: WorldState) -> list[Outcome]:
         c = self.config
         pool = cand.Pool(state)
-        if c.planner:
-            cand.planner_plans(pool, self.rng, limit=c.planner_limit, prefixes=self.signal == "preference")
+        self.planner_candidates(pool, self.rng, c.planner_limit, prefixes=self.signal == "preference")
         if c.feature_depth:
             mask = np.zeros(len(FEATURE_NAMES), bool)
             mask[self.idx] = True
@@ -271,10 +275,9 @@ class RewardLearner(Learner):
         if got is None:
             pool = cand.Pool(state, keep_nothing=True)
             pool.add([])
-            if self.config.planner:
-                digest = int.from_bytes(hashlib.sha256(repr(key).encode()).digest()[:8], "little")
-                rng = np.random.default_rng([self._final_seed, digest])
-                cand.planner_plans(pool, rng, limit=self.config.planner_limit, prefixes=False)
+            digest = int.from_bytes(hashlib.sha256(repr(key).encode()).digest()[:8], "little")
+            rng = np.random.default_rng([self._final_seed, digest])
+            self.planner_candidates(pool, rng, self.config.planner_limit, prefixes=False)
             got = self._final_outs[key] = pool.outs
         return got
 
@@ -284,7 +287,7 @@ class RewardLearner(Learner):
         b = self.belief
         return {"features": len(self.idx), "particles": len(b.W), "ess": round(b.ess(), 1),
                 "mean_norm": round(float(np.linalg.norm(b.mean())), 4),
-                "accept": [round(a, 3) for a in b.accept], "planner": self.config.planner,
+                "accept": [round(a, 3) for a in b.accept], "planner": self.uses_planner,
                 "z": self.describe(5)}
 
     def diagnostics(self) -> dict:
