@@ -136,3 +136,10 @@ def test_a_folder_of_an_older_format_is_refused_not_compared(tmp_path):
     (folder / "results.jsonl").write_text(json.dumps({**line, "format": FORMAT_VERSION - 1}) + "\n")
     with pytest.raises(StaleFolder, match="regenerate"):
         verify(folder, sample=1)
+
+
+def test_the_results_index_names_every_folder():
+    index = (RESULTS / "README.md").read_text()
+    folders = [p for p in [*RESULTS.iterdir(), *EXPERIMENTS.glob("*/results/*")] if p.is_dir()]
+    missing = [p.name for p in folders if f"[{p.name}]" not in index and f"`{p.name}`" not in index]
+    assert folders and not missing, missing
