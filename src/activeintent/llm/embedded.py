@@ -44,9 +44,10 @@ class EmbeddedConfig(BaseModel):
     model_dir: Path = Field(default_factory=default_model_dir)
     grammar_first: bool = Field(
         default=True,
-        description="structured answers at temperature 0: ask the grammar about the most likely "
-        "token first, the whole vocabulary only when it refuses (the same tokens as llama.cpp's "
-        "grammar-then-greedy chain, several times less grammar work; off: llama.cpp's chain)",
+        description="structured answers: ask the grammar about the most likely tokens first, the "
+        "whole vocabulary only when it refuses them (the same tokens as llama.cpp's grammar-then-"
+        "greedy chain at temperature 0, the same draws as its grammar-then-sampling chain above 0, "
+        "several times less grammar work; off: llama.cpp's chain)",
     )
     reuse_prefix: bool = Field(
         default=True,
@@ -138,18 +139,26 @@ def kept_prefix(llama: Any, tokens: list[int]) -> int:
 
 
 def _offer_grammar_first(llama: Any) -> None:
-    """Let ``llama`` decode a structured answer at temperature 0 with GrammarFirstGreedy when
-    the call asks for it (``llama.grammar_first``, set per call: backends share one Llama)."""
-    from activeintent.llm.grammar_greedy import GrammarFirstGreedy
+    """Let ``llama`` decode a structured answer with GrammarFirstGreedy (temperature 0) or
+    GrammarFirstSampling (temperature > 0) when the call asks for it (``llama.grammar_first``,
+    set per call: backends share one Llama)."""
+    from activeintent.llm.grammar_greedy import GrammarFirstGreedy, GrammarFirstSampling
 
     chain = llama._init_sampler  # llama-cpp-python builds each generation's sampler here
 
     def init_sampler(**kw):
-        plain = (kw.get("temp") == 0.0 and kw.get("logits_processor") is None and kw.get("mirostat_mode", 0) == 0
+        plain = (kw.get("logits_processor") is None and kw.get("mirostat_mode", 0) == 0
                  and kw.get("repeat_penalty", 1.0) == 1.0 and kw.get("frequency_penalty", 0.0) == 0.0
                  and kw.get("presence_penalty", 0.0) == 0.0)
         if kw.get("grammar") is not None and plain and getattr(llama, "grammar_first", False):
-            return GrammarFirstGreedy(llama._model.vocab, kw["grammar"], llama.n_vocab())
+            temp = kw.get("temp", 0.8)
+            if temp == 0.0:
+                return GrammarFirstGreedy(llama._model.vocab, kw["grammar"], llama.n_vocab())
+            if temp > 0.0:
+                return GrammarFirstSampling(llama._model.vocab, kw["grammar"], llama.n_vocab(),
+                                            top_k=kw.get("top_k", 40), typical_p=kw.get("typical_p", 1.0),
+                                            top_p=kw.get("top_p", 0.95), min_p=kw.get("min_p", 0.05), temp=temp,
+                                            seed=llama._seed)
         return chain(**kw)
 
     llama._init_sampler = init_sampler
