@@ -18,7 +18,13 @@ from typing import Any
 from pydantic import BaseModel, Field
 
 from activeintent.llm.backend import Backend, ChatRequest, Completion
-from activeintent.llm.base import Message, ModelError, ModelUnavailableError, StructuredOutputError
+from activeintent.llm.base import (
+    ContextOverflowError,
+    Message,
+    ModelError,
+    ModelUnavailableError,
+    StructuredOutputError,
+)
 
 # ggml waits at an OpenMP barrier after every operation. libgomp's default spin (300,000 turns)
 # holds a core another process may need (a learner-sized call took 4.4 s with one core busy);
@@ -30,6 +36,30 @@ if "OMP_WAIT_POLICY" not in os.environ:
     os.environ.setdefault("GOMP_SPINCOUNT", "300")
 
 
+MAX_AUTO_CTX = 32768  # the KV cache is allocated whole: a 128k model gets this by default
+
+
+def gguf_context_length(path: Path) -> int | None:
+    """The context length a GGUF was trained for (its ``<arch>.context_length``), read from the
+    file's metadata with the vocabulary only (no weights)."""
+    from llama_cpp import Llama
+
+    try:
+        meta = Llama(model_path=str(path), vocab_only=True, verbose=False).metadata
+    except ValueError:
+        return None
+    arch = meta.get("general.architecture", "")
+    value = meta.get(f"{arch}.context_length")
+    return int(value) if value and str(value).isdigit() else None
+
+
+def context_size(path: Path, config: EmbeddedConfig) -> int:
+    """The context window a Llama gets: ``n_ctx`` when set, else the GGUF's own (≤ MAX_AUTO_CTX)."""
+    if config.n_ctx is not None:
+        return config.n_ctx
+    return min(gguf_context_length(path) or 4096, MAX_AUTO_CTX)
+
+
 def default_model_dir() -> Path:
     return Path.home() / ".cache" / "activeintent" / "models"
 
@@ -37,7 +67,11 @@ def default_model_dir() -> Path:
 class EmbeddedConfig(BaseModel):
     """Settings of the in-process model (the defaults suit a 2-core laptop)."""
 
-    n_ctx: int = Field(default=4096, ge=256, description="context window in tokens")
+    n_ctx: int | None = Field(
+        default=None, ge=256,
+        description="context window in tokens (default: the GGUF's trained context length, at most "
+        f"{MAX_AUTO_CTX}: the packaged Gemma 3 270M's 32,768, which the paper learners' whole-episode "
+        "conversations need)")
     n_threads: int = Field(default_factory=lambda: os.cpu_count() or 1, ge=1)
     n_batch: int = Field(default=512, ge=8)
     seed: int = 0
@@ -97,17 +131,18 @@ _LOAD_LOCK = threading.Lock()
 
 
 def load_llama(path: Path, config: EmbeddedConfig) -> Any:
-    key = (str(Path(path).resolve()), config.n_ctx, config.n_threads, config.n_batch, config.seed)
+    if not Path(path).is_file():
+        raise ModelUnavailableError(f"no GGUF model file at {path}")
+    n_ctx = context_size(Path(path), config)
+    key = (str(Path(path).resolve()), n_ctx, config.n_threads, config.n_batch, config.seed)
     with _LOAD_LOCK:
         if key not in _LOADED:
-            if not Path(path).is_file():
-                raise ModelUnavailableError(f"no GGUF model file at {path}")
             from llama_cpp import Llama
 
             try:
                 _LOADED[key] = Llama(
                     model_path=str(path),
-                    n_ctx=config.n_ctx,
+                    n_ctx=n_ctx,
                     n_threads=config.n_threads,
                     n_threads_batch=config.n_threads,
                     n_batch=config.n_batch,
@@ -167,6 +202,11 @@ def _offer_grammar_first(llama: Any) -> None:
 
 _LOOSE_CHAR = r'char ::= [^"\\] |'
 _JSON_CHAR = r'char ::= [^"\\\x7F\x00-\x1F] |'
+
+
+# A prompt must leave this many tokens (or max_tokens, when fewer) for the answer: llama.cpp
+# would otherwise cut the answer at the window's end, and a cut answer never parses.
+ANSWER_ROOM = 700
 
 
 # llama.cpp unrolls a bounded repetition into nested rules and refuses large bounds; longer
@@ -252,6 +292,7 @@ class EmbeddedBackend(Backend):
             "turns" if self._has_turn_markers() else "plain"
         )
         self._lock = _CALL_LOCKS[id(self.llama)]
+        self.n_ctx = int(self.llama.n_ctx())
 
     def _check_grammar(self, grammar) -> None:
         """llama.cpp returns no sampler for a grammar it cannot parse, and using none crashes
@@ -288,6 +329,10 @@ class EmbeddedBackend(Backend):
                 # template's prompt is built inside llama-cpp-python: evaluated from scratch)
                 prompt = (turn_prompt if self.prompt_format == "turns" else plain_prompt)(request.messages)
                 prompt_tokens = self.llama.tokenize(prompt.encode("utf-8"), special=True)
+            if prompt_tokens is not None and len(prompt_tokens) + min(request.max_tokens, ANSWER_ROOM) > self.n_ctx:
+                raise ContextOverflowError(
+                    f"embedded {self.model_name}: the prompt ({len(prompt_tokens)} tokens) leaves no room for an "
+                    f"answer in the context window of {self.n_ctx} tokens")
             keep = kept_prefix(self.llama, prompt_tokens) if self.config.reuse_prefix and prompt_tokens else 0
             self.llama.prompt_tokens = None  # until this prompt is evaluated
             if keep:
@@ -316,7 +361,8 @@ class EmbeddedBackend(Backend):
                     )
                     text = out["choices"][0]["text"]
             except ValueError as exc:  # e.g. the prompt exceeds n_ctx
-                raise ModelError(f"embedded {self.model_name}: {exc}") from exc
+                kind = ContextOverflowError if "context window" in str(exc) else ModelError
+                raise kind(f"embedded {self.model_name}: {exc}") from exc
             self.llama.prompt_tokens = prompt_tokens
         usage = out.get("usage") or {}
         return Completion(
