@@ -210,8 +210,12 @@ ANSWER_ROOM = 700
 
 
 # llama.cpp unrolls a bounded repetition into nested rules and refuses large bounds; longer
-# limits are left to pydantic validation (and the repair round) instead of the grammar.
-GRAMMAR_MAX_REPEAT = 200
+# limits are left to pydantic validation (and the repair round) instead of the grammar. 1200
+# keeps every bound of the paper learners' answers in the grammar (reasoning ≤ 1200 characters,
+# z ≤ 300, y ≤ 400): sampled at T = 1 the base model's reasoning otherwise ran on to max_tokens
+# (700), the cut answer never parsed, and each of its repair rounds did the same (a test scene
+# took 3 × 700 tokens and then had no answer). Sampling speed is the same as at 200.
+GRAMMAR_MAX_REPEAT = 1200
 
 
 def _loosen(node: object) -> object:
