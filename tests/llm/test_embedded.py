@@ -241,3 +241,21 @@ def test_the_openmp_wait_is_a_short_spin_unless_the_user_chose(given, spin):
                           "print(os.environ.get('GOMP_SPINCOUNT'))"], env=env, capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == str(spin)
+
+
+def test_the_planner_gets_its_own_kv_cache_and_the_context_is_the_ggufs(gguf_path):
+    """The embedded model's window is the GGUF's trained 32k (the paper learners' conversations
+    overflowed 4,096); the executor plans with the same weights in a separate Llama, so the
+    learner's conversation and the planner's fixed prompt each keep their prefix; counted in
+    the run's usage."""
+    from activeintent.llm.embedded import gguf_context_length
+    from activeintent.runner import EXECUTOR_CTX, Models
+    from activeintent.spec import ModelsConfig
+
+    assert gguf_context_length(gguf_path) == 32768
+    models = Models(ModelsConfig(llm="embedded", cache_mode="off"))
+    learner, planner = models.llm, models.executor_llm
+    assert learner.backend.n_ctx == 32768 and planner.backend.n_ctx == EXECUTOR_CTX
+    assert planner.backend.llama is not learner.backend.llama and planner.name == learner.name
+    planner.chat(ASK, max_tokens=8)
+    assert models.usage()[0] == 1

@@ -83,6 +83,12 @@ class EmbeddedConfig(BaseModel):
         "greedy chain at temperature 0, the same draws as its grammar-then-sampling chain above 0, "
         "several times less grammar work; off: llama.cpp's chain)",
     )
+    kv_slot: str = Field(
+        default="",
+        description="backends with different slots hold separate Llamas (so KV caches) of the same file: "
+        "two families of prompts that alternate (the learner's conversation, the planner's fixed prompt) "
+        "each keep their shared prefix",
+    )
     reuse_prefix: bool = Field(
         default=True,
         description="keep the KV cache of the part shared with the previous prompt, in whole "
@@ -134,7 +140,7 @@ def load_llama(path: Path, config: EmbeddedConfig) -> Any:
     if not Path(path).is_file():
         raise ModelUnavailableError(f"no GGUF model file at {path}")
     n_ctx = context_size(Path(path), config)
-    key = (str(Path(path).resolve()), n_ctx, config.n_threads, config.n_batch, config.seed)
+    key = (str(Path(path).resolve()), n_ctx, config.n_threads, config.n_batch, config.seed, config.kv_slot)
     with _LOAD_LOCK:
         if key not in _LOADED:
             from llama_cpp import Llama
