@@ -182,6 +182,13 @@ def run(
     except ValueError as err:
         console.print(f"[red]error:[/red] {escape(str(err))}", soft_wrap=True)
         raise typer.Exit(2) from None
+    note = None
+    if (test_scenes, test_pool) == (D.test_scenes, D.test_pool) and method_asks_a_model(method):
+        # Every test scene is a model call (and a planner call) for these learners: a curve of
+        # 10 scenes at k = 0…K and a pool of 70 at K took most of an hour on 2 cores.
+        spec = spec.with_options(curve=False, test_pool=0)
+        note = (f"{method} asks the model for every test scene: scored at k = {budget} only, on the "
+                f"{test_scenes} curve scenes (--test-pool N adds the pool and the curve; bench scores the whole protocol)")
     name = intention or (Path(intention_file.split(":")[0]).stem if intention_file else DEFAULT_INTENTION)
     out_dir = out or Path("runs") / f"{method}-{name}-seed{seed}"
     live = LiveTable(console, method, budget, seed, llm=llm, lines=not console.is_terminal)
@@ -196,6 +203,8 @@ def run(
             console.print(f"[red]error:[/red] {escape(str(err))}", soft_wrap=True)
             raise typer.Exit(2) from None
         return
+    if note:
+        console.print(note, soft_wrap=True, highlight=False, markup=False)
     try:
         if live.lines:  # a log sees a live display only at the end: plain lines instead
             print_line(console, f"loading models and simulator… ({'no model' if llm == 'none' else 'model ' + llm})")
@@ -237,6 +246,16 @@ def run(
         f"{result.method} on {result.intention} · final z = “{escape(result.final_z)}” · {result.signals_used} signals "
         f"{dict(result.answers)} · {model_summary(llm, result.llm_calls, errors)} · {result.wall_s:.0f} s · "
         f"{out_dir}/summary.json", soft_wrap=True)
+
+
+def method_asks_a_model(method: str) -> bool:
+    """Whether the method's learner needs a language model (an unknown name: False, refused later)."""
+    from activeintent.learners.registry import get_method
+
+    try:
+        return bool(get_method(method).needs_llm)
+    except (KeyError, ValueError):
+        return False
 
 
 def plain_console():

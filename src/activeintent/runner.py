@@ -16,6 +16,9 @@ from activeintent.spec import DEFAULT_INTENTION, DEFAULT_METHOD, ModelsConfig, R
 __all__ = ["DEFAULT_INTENTION", "DEFAULT_METHOD", "Models", "RunSpec", "build_episode", "check_spec"]
 
 
+EXECUTOR_CTX = 8192  # the planner's prompts are ~750 tokens and its answers short
+
+
 class Models:
     """The models a run uses, loaded on first use (Bayesian methods may need none)."""
 
@@ -40,6 +43,25 @@ class Models:
     @property
     def vlm(self):
         return self._load(self.config.vlm)
+
+    @property
+    def executor_llm(self):
+        """The LLM the executor plans with: the same model, but an in-process one gets its own
+        KV cache (EXECUTOR_SLOT), so neither the learner's growing conversation nor the
+        planner's fixed prompt evicts the other's prefix (the same answers: a kept prefix gives
+        the logits of a fresh evaluation)."""
+        spec = self.config.llm
+        if spec is None or spec == "none" or not (spec == "embedded" or spec.startswith("gguf:")):
+            return self.llm
+        key = f"{spec}#executor"
+        if key not in self._loaded:
+            from activeintent.llm.embedded import EmbeddedConfig
+            from activeintent.llm.registry import load_model
+
+            c = self.config
+            self._loaded[key] = load_model(spec, base_url=c.base_url, cache_path=c.cache, cache_mode=c.cache_mode,
+                                           embedded=EmbeddedConfig(kv_slot="executor", n_ctx=EXECUTOR_CTX))
+        return self._loaded[key]
 
     def _totals(self):
         return [m.usage.snapshot() for m in self._loaded.values() if m is not None and m.usage is not None]
@@ -107,7 +129,7 @@ def build_episode(
     seeds = spec.seeds  # the one split of the seed: the learner's and the user's streams come from it
     llm = models.llm
     learner = method(LearnerContext(llm=llm, vlm=models.vlm, learner_seed=seeds.learner, config=learning))
-    executor = make_executor(learning.executor, model=llm, parser_first=learning.variant == "structured")
+    executor = make_executor(learning.executor, model=models.executor_llm if llm is not None else None, parser_first=learning.variant == "structured")
     if user is None:
         user = SimulatedUser(intention, method.signal, user_profile(who.preset), rng=seeds.user)
         if spec.protocol.new_scene == "off":

@@ -217,6 +217,18 @@ def test_explain_finds_the_goal_of_a_sentence():
     assert not explain("Juggle while singing loudly")["lexical_match"]
 
 
+def test_explain_ranks_a_relation_s_direction_by_the_sentence_s_word_order():
+    """ "the blue block on the red block" shares every word with its reverse: the reading in
+    the sentence's order comes first, and above the reverse, not tied with it."""
+    from activeintent.learners.lang.explain import explain
+
+    for top, other in (("blue", "red"), ("red", "blue")):
+        rows = explain(f"put the {top} block on the {other} block")["matches"]
+        assert rows[0]["sentence"] == f"Every {top} block is on the {other} block."
+        reverse = next(r for r in rows if r["sentence"] == f"Every {other} block is on the {top} block.")
+        assert rows[0]["score"] > reverse["score"]
+
+
 def test_every_sampled_goal_of_the_space_gets_a_plan_wherever_it_is_called_feasible():
     """Per goal, no tolerance, over a fixed bank of seeded scenes and layouts, for a sample of
     the learner's space: a goal the space's judge calls feasible gets plans that satisfy it, or

@@ -382,3 +382,51 @@ def test_the_scene_choice_is_a_turn_of_the_conversation():
     learner = FaithfulMllmLlmLearner(too_many, config=FaithfulConfig(seed=1))
     assert learner.design_scene() is None  # 6 objects: the episode samples one
     assert "at most 5" in learner.drain_transcript()[-1]["unusable"]
+
+
+def test_identical_showcases_are_asked_again():
+    """Goals A and B the same (up to case and a full stop): the learner asks again in the same
+    conversation, and the round shows two different goals."""
+    same = {"reasoning": "r", "preference": "matching colours", "goal_a": "Put the red block in the red bowl.",
+            "goal_b": "put the red block in the red bowl", "done": False}
+    differ = {**same, "goal_b": "put the blue block on the red block"}
+    model = ScriptedModel([same, differ], accepts_images=False)
+    learner = FaithfulPreferenceLearner(model, NO_DESIGN)
+    est = learner.estimate(SCENE, state())
+    assert est.goals == ["Put the red block in the red bowl.", "put the blue block on the red block"]
+    assert est.why["reasked_same_goals"] == 1 and len(model.calls) == 2
+    assert "Goals A and B are the same" in model.calls[1].messages[-1].text
+    assert [m.role for m in model.calls[1].messages] == ["system", "user", "assistant", "user"]
+
+
+def test_identical_showcases_are_asked_again_at_most_twice():
+    same = {"reasoning": "r", "preference": "p", "goal_a": "stack them", "goal_b": "stack them", "done": False}
+    model = ScriptedModel(respond=lambda m, s: same, accepts_images=False)
+    est = FaithfulPreferenceLearner(model, NO_DESIGN).estimate(SCENE, state())
+    assert est.goals == ["stack them", "stack them"] and len(model.calls) == 3
+
+
+def test_a_history_longer_than_the_context_is_summarised_oldest_first():
+    """A model whose context holds only a few messages (ContextOverflowError, as the embedded
+    backend raises it): the learner drops its oldest exchanges into a summary in the system turn
+    (the person's answers and its own preference and goals kept) and every round and test scene
+    still gets an answer; before, the episode ended with a model error."""
+    from activeintent.llm.base import ContextOverflowError
+
+    def small_context(messages, schema):
+        if len(messages) > 5:
+            raise ContextOverflowError("the prompt leaves no room for an answer")
+        return respond(messages, schema)
+
+    model = ScriptedModel(respond=small_context, accepts_images=False)
+    learner = FaithfulPreferenceLearner(model, NO_DESIGN)
+    for i, choice in enumerate("ABA"):
+        est = learner.estimate(SCENE, state())
+        assert est.goals == ["tidy the blocks into bowls", "build a tower"]
+        learner.observe(RoundRecord(index=i, scene=SCENE, estimate=est, answer=PreferenceAnswer(choice=choice)), [])
+    assert learner.final(SCENE, state()).goals == ["tidy the blocks into bowls"]
+    system = model.calls[-1].messages[0].text
+    assert "Earlier rounds, in short" in system
+    assert 'preferred goal A ("tidy the blocks into bowls")' in system and "“matching colours”" in system
+    assert "goal b: “build a tower”" in system
+    assert len(model.calls[-1].messages) <= 5 and learner.stats()["summarised"] >= 2

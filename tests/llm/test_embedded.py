@@ -136,6 +136,31 @@ def test_grammar_first_decoding_gives_llama_cpps_own_tokens(gguf_path):
     assert 0 < whole < fallbacks < steps  # the argmax, the shortlist and the whole vocabulary
 
 
+def test_grammar_first_sampling_draws_llama_cpps_own_tokens(gguf_path):
+    """Above temperature 0, GrammarFirstSampling (the default) writes byte for byte what
+    llama.cpp's grammar-then-sampling chain writes with the same seed, for the paper learners'
+    answer schema (free text after reasoning) and a schema the grammar must force; both the
+    shortlist and the whole vocabulary are taken."""
+    from activeintent.learners.paper.schemas import faithful_answer_schema
+    from activeintent.llm.backend import ChatRequest
+    from activeintent.llm.embedded import EmbeddedBackend, EmbeddedConfig
+    from activeintent.llm.grammar_greedy import GrammarFirstSampling
+
+    on = EmbeddedBackend(None, EmbeddedConfig(grammar_first=True))
+    off = EmbeddedBackend(None, EmbeddedConfig(grammar_first=False))
+    steps = whole = 0
+    for seed, schema in ((0, faithful_answer_schema(1)), (1, faithful_answer_schema(2)), (2, Pick)):
+        request = ChatRequest(messages=ASK, max_tokens=48, seed=seed, temperature=1.0,
+                              json_schema=schema.model_json_schema(), schema_name=schema.__name__)
+        want, got = off.complete(request), on.complete(request)
+        assert (got.text, got.completion_tokens, got.finish_reason) == (want.text, want.completion_tokens,
+                                                                         want.finish_reason)
+        sampler = on.llama._sampler
+        assert isinstance(sampler, GrammarFirstSampling)
+        steps, whole = steps + sampler.steps, whole + sampler.whole
+    assert 0 < whole < steps
+
+
 def test_the_shortlist_gives_the_whole_vocabularys_token_ties_included():
     """When the grammar refuses the argmax, the most likely allowed token of the shortlist is
     the most likely allowed token of the whole vocabulary (lowest id among equal logits), and
@@ -216,3 +241,21 @@ def test_the_openmp_wait_is_a_short_spin_unless_the_user_chose(given, spin):
                           "print(os.environ.get('GOMP_SPINCOUNT'))"], env=env, capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == str(spin)
+
+
+def test_the_planner_gets_its_own_kv_cache_and_the_context_is_the_ggufs(gguf_path):
+    """The embedded model's window is the GGUF's trained 32k (the paper learners' conversations
+    overflowed 4,096); the executor plans with the same weights in a separate Llama, so the
+    learner's conversation and the planner's fixed prompt each keep their prefix; counted in
+    the run's usage."""
+    from activeintent.llm.embedded import gguf_context_length
+    from activeintent.runner import EXECUTOR_CTX, Models
+    from activeintent.spec import ModelsConfig
+
+    assert gguf_context_length(gguf_path) == 32768
+    models = Models(ModelsConfig(llm="embedded", cache_mode="off"))
+    learner, planner = models.llm, models.executor_llm
+    assert learner.backend.n_ctx == 32768 and planner.backend.n_ctx == EXECUTOR_CTX
+    assert planner.backend.llama is not learner.backend.llama and planner.name == learner.name
+    planner.chat(ASK, max_tokens=8)
+    assert models.usage()[0] == 1

@@ -22,6 +22,23 @@ def test_long_bounds_are_left_to_validation():
     assert schema["properties"]["items"]["maxItems"] == 5 <= GRAMMAR_MAX_REPEAT
 
 
+def test_the_paper_learners_answer_bounds_are_in_the_grammar():
+    """The faithful answer's reasoning, z and y bounds reach the grammar, so a sampled answer
+    cannot run on to max_tokens and be cut (it was, and every repair round was cut again)."""
+    from activeintent.learners.paper.schemas import (
+        FaithfulRetrieval,
+        faithful_answer_schema,
+        faithful_scene_schema,
+    )
+
+    for schema in (faithful_answer_schema(1), faithful_answer_schema(2, with_done=True), FaithfulRetrieval,
+                   faithful_scene_schema()):
+        props = _loosen(schema.model_json_schema())["properties"]
+        for name, prop in props.items():
+            if prop.get("type") == "string":
+                assert 0 < prop["maxLength"] <= GRAMMAR_MAX_REPEAT, (schema.__name__, name)
+
+
 @pytest.mark.slow
 def test_embedded_answers_a_long_bounded_schema_and_refuses_bad_grammar():
     from llama_cpp import LlamaGrammar

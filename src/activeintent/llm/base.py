@@ -85,6 +85,11 @@ class AnswerTooDeepError(ModelError):
     unparsed and not repaired, an error of the call rather than an unusable answer."""
 
 
+class ContextOverflowError(ModelError):
+    """The prompt and its answer do not fit the model's context window (``n_ctx`` tokens). A
+    caller that holds a long history can shorten it and ask again."""
+
+
 class ImagesNotSupportedError(ModelError):
     """Images were sent to a text-only model (never dropped silently)."""
 

@@ -18,7 +18,13 @@ from typing import Any
 from pydantic import BaseModel, Field
 
 from activeintent.llm.backend import Backend, ChatRequest, Completion
-from activeintent.llm.base import Message, ModelError, ModelUnavailableError, StructuredOutputError
+from activeintent.llm.base import (
+    ContextOverflowError,
+    Message,
+    ModelError,
+    ModelUnavailableError,
+    StructuredOutputError,
+)
 
 # ggml waits at an OpenMP barrier after every operation. libgomp's default spin (300,000 turns)
 # holds a core another process may need (a learner-sized call took 4.4 s with one core busy);
@@ -30,6 +36,30 @@ if "OMP_WAIT_POLICY" not in os.environ:
     os.environ.setdefault("GOMP_SPINCOUNT", "300")
 
 
+MAX_AUTO_CTX = 32768  # the KV cache is allocated whole: a 128k model gets this by default
+
+
+def gguf_context_length(path: Path) -> int | None:
+    """The context length a GGUF was trained for (its ``<arch>.context_length``), read from the
+    file's metadata with the vocabulary only (no weights)."""
+    from llama_cpp import Llama
+
+    try:
+        meta = Llama(model_path=str(path), vocab_only=True, verbose=False).metadata
+    except ValueError:
+        return None
+    arch = meta.get("general.architecture", "")
+    value = meta.get(f"{arch}.context_length")
+    return int(value) if value and str(value).isdigit() else None
+
+
+def context_size(path: Path, config: EmbeddedConfig) -> int:
+    """The context window a Llama gets: ``n_ctx`` when set, else the GGUF's own (≤ MAX_AUTO_CTX)."""
+    if config.n_ctx is not None:
+        return config.n_ctx
+    return min(gguf_context_length(path) or 4096, MAX_AUTO_CTX)
+
+
 def default_model_dir() -> Path:
     return Path.home() / ".cache" / "activeintent" / "models"
 
@@ -37,16 +67,27 @@ def default_model_dir() -> Path:
 class EmbeddedConfig(BaseModel):
     """Settings of the in-process model (the defaults suit a 2-core laptop)."""
 
-    n_ctx: int = Field(default=4096, ge=256, description="context window in tokens")
+    n_ctx: int | None = Field(
+        default=None, ge=256,
+        description="context window in tokens (default: the GGUF's trained context length, at most "
+        f"{MAX_AUTO_CTX}: the packaged Gemma 3 270M's 32,768, which the paper learners' whole-episode "
+        "conversations need)")
     n_threads: int = Field(default_factory=lambda: os.cpu_count() or 1, ge=1)
     n_batch: int = Field(default=512, ge=8)
     seed: int = 0
     model_dir: Path = Field(default_factory=default_model_dir)
     grammar_first: bool = Field(
         default=True,
-        description="structured answers at temperature 0: ask the grammar about the most likely "
-        "token first, the whole vocabulary only when it refuses (the same tokens as llama.cpp's "
-        "grammar-then-greedy chain, several times less grammar work; off: llama.cpp's chain)",
+        description="structured answers: ask the grammar about the most likely tokens first, the "
+        "whole vocabulary only when it refuses them (the same tokens as llama.cpp's grammar-then-"
+        "greedy chain at temperature 0, the same draws as its grammar-then-sampling chain above 0, "
+        "several times less grammar work; off: llama.cpp's chain)",
+    )
+    kv_slot: str = Field(
+        default="",
+        description="backends with different slots hold separate Llamas (so KV caches) of the same file: "
+        "two families of prompts that alternate (the learner's conversation, the planner's fixed prompt) "
+        "each keep their shared prefix",
     )
     reuse_prefix: bool = Field(
         default=True,
@@ -96,17 +137,18 @@ _LOAD_LOCK = threading.Lock()
 
 
 def load_llama(path: Path, config: EmbeddedConfig) -> Any:
-    key = (str(Path(path).resolve()), config.n_ctx, config.n_threads, config.n_batch, config.seed)
+    if not Path(path).is_file():
+        raise ModelUnavailableError(f"no GGUF model file at {path}")
+    n_ctx = context_size(Path(path), config)
+    key = (str(Path(path).resolve()), n_ctx, config.n_threads, config.n_batch, config.seed, config.kv_slot)
     with _LOAD_LOCK:
         if key not in _LOADED:
-            if not Path(path).is_file():
-                raise ModelUnavailableError(f"no GGUF model file at {path}")
             from llama_cpp import Llama
 
             try:
                 _LOADED[key] = Llama(
                     model_path=str(path),
-                    n_ctx=config.n_ctx,
+                    n_ctx=n_ctx,
                     n_threads=config.n_threads,
                     n_threads_batch=config.n_threads,
                     n_batch=config.n_batch,
@@ -138,18 +180,26 @@ def kept_prefix(llama: Any, tokens: list[int]) -> int:
 
 
 def _offer_grammar_first(llama: Any) -> None:
-    """Let ``llama`` decode a structured answer at temperature 0 with GrammarFirstGreedy when
-    the call asks for it (``llama.grammar_first``, set per call: backends share one Llama)."""
-    from activeintent.llm.grammar_greedy import GrammarFirstGreedy
+    """Let ``llama`` decode a structured answer with GrammarFirstGreedy (temperature 0) or
+    GrammarFirstSampling (temperature > 0) when the call asks for it (``llama.grammar_first``,
+    set per call: backends share one Llama)."""
+    from activeintent.llm.grammar_greedy import GrammarFirstGreedy, GrammarFirstSampling
 
     chain = llama._init_sampler  # llama-cpp-python builds each generation's sampler here
 
     def init_sampler(**kw):
-        plain = (kw.get("temp") == 0.0 and kw.get("logits_processor") is None and kw.get("mirostat_mode", 0) == 0
+        plain = (kw.get("logits_processor") is None and kw.get("mirostat_mode", 0) == 0
                  and kw.get("repeat_penalty", 1.0) == 1.0 and kw.get("frequency_penalty", 0.0) == 0.0
                  and kw.get("presence_penalty", 0.0) == 0.0)
         if kw.get("grammar") is not None and plain and getattr(llama, "grammar_first", False):
-            return GrammarFirstGreedy(llama._model.vocab, kw["grammar"], llama.n_vocab())
+            temp = kw.get("temp", 0.8)
+            if temp == 0.0:
+                return GrammarFirstGreedy(llama._model.vocab, kw["grammar"], llama.n_vocab())
+            if temp > 0.0:
+                return GrammarFirstSampling(llama._model.vocab, kw["grammar"], llama.n_vocab(),
+                                            top_k=kw.get("top_k", 40), typical_p=kw.get("typical_p", 1.0),
+                                            top_p=kw.get("top_p", 0.95), min_p=kw.get("min_p", 0.05), temp=temp,
+                                            seed=llama._seed)
         return chain(**kw)
 
     llama._init_sampler = init_sampler
@@ -160,9 +210,18 @@ _LOOSE_CHAR = r'char ::= [^"\\] |'
 _JSON_CHAR = r'char ::= [^"\\\x7F\x00-\x1F] |'
 
 
+# A prompt must leave this many tokens (or max_tokens, when fewer) for the answer: llama.cpp
+# would otherwise cut the answer at the window's end, and a cut answer never parses.
+ANSWER_ROOM = 700
+
+
 # llama.cpp unrolls a bounded repetition into nested rules and refuses large bounds; longer
-# limits are left to pydantic validation (and the repair round) instead of the grammar.
-GRAMMAR_MAX_REPEAT = 200
+# limits are left to pydantic validation (and the repair round) instead of the grammar. 1200
+# keeps every bound of the paper learners' answers in the grammar (reasoning ≤ 1200 characters,
+# z ≤ 300, y ≤ 400): sampled at T = 1 the base model's reasoning otherwise ran on to max_tokens
+# (700), the cut answer never parsed, and each of its repair rounds did the same (a test scene
+# took 3 × 700 tokens and then had no answer). Sampling speed is the same as at 200.
+GRAMMAR_MAX_REPEAT = 1200
 
 
 def _loosen(node: object) -> object:
@@ -243,6 +302,7 @@ class EmbeddedBackend(Backend):
             "turns" if self._has_turn_markers() else "plain"
         )
         self._lock = _CALL_LOCKS[id(self.llama)]
+        self.n_ctx = int(self.llama.n_ctx())
 
     def _check_grammar(self, grammar) -> None:
         """llama.cpp returns no sampler for a grammar it cannot parse, and using none crashes
@@ -279,6 +339,10 @@ class EmbeddedBackend(Backend):
                 # template's prompt is built inside llama-cpp-python: evaluated from scratch)
                 prompt = (turn_prompt if self.prompt_format == "turns" else plain_prompt)(request.messages)
                 prompt_tokens = self.llama.tokenize(prompt.encode("utf-8"), special=True)
+            if prompt_tokens is not None and len(prompt_tokens) + min(request.max_tokens, ANSWER_ROOM) > self.n_ctx:
+                raise ContextOverflowError(
+                    f"embedded {self.model_name}: the prompt ({len(prompt_tokens)} tokens) leaves no room for an "
+                    f"answer in the context window of {self.n_ctx} tokens")
             keep = kept_prefix(self.llama, prompt_tokens) if self.config.reuse_prefix and prompt_tokens else 0
             self.llama.prompt_tokens = None  # until this prompt is evaluated
             if keep:
@@ -307,7 +371,8 @@ class EmbeddedBackend(Backend):
                     )
                     text = out["choices"][0]["text"]
             except ValueError as exc:  # e.g. the prompt exceeds n_ctx
-                raise ModelError(f"embedded {self.model_name}: {exc}") from exc
+                kind = ContextOverflowError if "context window" in str(exc) else ModelError
+                raise kind(f"embedded {self.model_name}: {exc}") from exc
             self.llama.prompt_tokens = prompt_tokens
         usage = out.get("usage") or {}
         return Completion(

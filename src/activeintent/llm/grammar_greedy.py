@@ -83,3 +83,66 @@ class GrammarFirstGreedy:
                 token = int(every["id"][int(np.argmax(every["logit"]))])
         c.llama_sampler_accept(self.sampler, token)
         return token
+
+
+class GrammarFirstSampling(GrammarFirstGreedy):
+    """A llama-cpp-python sampler for temperature > 0 with a grammar: llama.cpp's chain
+    "grammar, top-k, typical, top-p, min-p, temperature, draw" with the grammar asked about the
+    shortlist first.
+
+    Only the top-k tokens the grammar allows go on past the grammar. When the shortlist (every
+    token whose logit reaches the SHORTLIST-th largest) holds at least k allowed tokens, those
+    are the k most likely allowed tokens of the whole vocabulary (every token outside has a
+    smaller logit), so the rest of the chain sees what it would see after the grammar had been
+    asked about all 262,144 tokens; else the grammar is asked about the whole vocabulary, as
+    llama.cpp does. The rest of the chain is llama.cpp's own samplers with the same seed, so a
+    draw is the draw llama.cpp's chain makes (ties at the k-th logit aside).
+    """
+
+    def __init__(self, vocab, grammar, n_vocab: int, *, top_k: int, typical_p: float, top_p: float, min_p: float,
+                 temp: float, seed: int):
+        super().__init__(vocab, grammar, n_vocab)
+        c = self._c
+        self.top_k = top_k
+        self.chain = c.llama_sampler_chain_init(c.llama_sampler_chain_default_params())
+        for sampler in (c.llama_sampler_init_top_k(top_k), c.llama_sampler_init_typical(typical_p, 1),
+                        c.llama_sampler_init_top_p(top_p, 1), c.llama_sampler_init_min_p(min_p, 1),
+                        c.llama_sampler_init_temp(temp), c.llama_sampler_init_dist(seed)):
+            c.llama_sampler_chain_add(self.chain, sampler)
+
+    def __del__(self):
+        if getattr(self, "chain", None):
+            self._c.llama_sampler_free(self.chain)
+            self.chain = None
+        super().__del__()
+
+    def _candidates(self, logits: np.ndarray) -> np.ndarray:
+        """The tokens the chain goes on with: the shortlist when it holds top_k allowed tokens
+        (refused ones at −inf), else the whole vocabulary after the grammar."""
+        self.steps += 1
+        if 0 < self.top_k <= SHORTLIST // 2:
+            edge = np.partition(logits, -SHORTLIST)[-SHORTLIST]
+            ids = np.flatnonzero(logits >= edge)
+            some = np.zeros(len(ids), _TOKEN_DATA)
+            some["id"], some["logit"] = ids, logits[ids]
+            self._apply(some)
+            if np.count_nonzero(~np.isneginf(some["logit"])) >= self.top_k:
+                return some
+        self.whole += 1
+        every = np.zeros(self.n_vocab, _TOKEN_DATA)
+        every["id"] = np.arange(self.n_vocab, dtype=np.int32)
+        every["logit"] = logits
+        self._apply(every)
+        return every
+
+    def sample(self, ctx, idx: int = -1) -> int:
+        c = self._c
+        logits = np.ctypeslib.as_array(c.llama_get_logits_ith(ctx.ctx, idx), shape=(self.n_vocab,))
+        data = self._candidates(logits)
+        arr = c.llama_token_data_array(
+            data=data.ctypes.data_as(ctypes.POINTER(c.llama_token_data)), size=len(data), selected=-1, sorted=False)
+        c.llama_sampler_apply(self.chain, ctypes.byref(arr))
+        token = int(data["id"][arr.selected])
+        c.llama_sampler_accept(self.sampler, token)
+        c.llama_sampler_accept(self.chain, token)
+        return token

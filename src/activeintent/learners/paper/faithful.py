@@ -23,6 +23,7 @@ What makes them faithful, against the ``structured`` variant in :mod:`activeinte
 
 from __future__ import annotations
 
+import json
 import time
 from typing import Literal
 
@@ -47,6 +48,7 @@ from activeintent.learners.paper.schemas import (
 from activeintent.learners.paper.structured import PaperLearnerConfig, failure_reason
 from activeintent.llm.base import (
     ChatModel,
+    ContextOverflowError,
     ImagePart,
     Message,
     ModelError,
@@ -59,6 +61,8 @@ from activeintent.world import ALL_OBJECTS, Scene, SceneError, WorldState, layou
 from activeintent.world.trajectory import Trajectory
 
 Part = TextPart | ImagePart
+SUMMARY_HEAD = ("Earlier rounds, in short (the whole conversation no longer fits your memory; "
+                "what the person's answers said and what you answered):")
 TEMPLATES = ("faithful_x", "faithful_scene", "faithful_eq12", "faithful_eq3", "faithful_eq4", "faithful_eq56",
              "faithful_final", "faithful_failed", "faithful_feedback")
 
@@ -91,6 +95,13 @@ def user_turn(parts: list[Part]) -> Message:
     return Message(role="user", content=list(parts))
 
 
+def same_goal(a: str, b: str) -> bool:
+    """Two goals that say the same, up to case, spacing and a final full stop."""
+    def norm(text: str) -> str:
+        return " ".join(text.casefold().split()).rstrip(".")
+    return norm(a) == norm(b)
+
+
 class _FaithfulLearner(Learner):
     """One conversation with p_θ per episode; subclasses say what feedback a round adds."""
 
@@ -106,6 +117,8 @@ class _FaithfulLearner(Learner):
         self.transcript: list[dict] = []
         system = _section("faithful_x", "x", objects=", ".join(ALL_OBJECTS)) + "\n" + _section("faithful_x", self.signal)
         self.conversation: list[Message] = [Message(role="system", content=system)]
+        self.feedback: list[str] = []  # per exchange of the conversation: the feedback its user turn carried
+        self.summarised: list[str] = []  # exchanges dropped from the conversation, one line each
         self.pending: list[Part] = []  # feedback not yet delivered: it opens the next user turn
         self._scoring = False  # between final() and the next round: failures belong to the test scene
         self._final: tuple[tuple[str, ...], list[Message]] | None = None  # last test-scene exchange
@@ -139,20 +152,52 @@ class _FaithfulLearner(Learner):
     def _converse(self, template: str, text: str, schema: type[BaseModel]) -> BaseModel | None:
         """Ask p_θ with the pending feedback and ``text`` as the next user turn; a usable answer
         joins the conversation (and the feedback is then delivered), else nothing changes."""
-        opening = [TextPart(text=_section("faithful_feedback", "first"))] if len(self.conversation) == 1 else []
-        turn = user_turn([*opening, *self.pending, TextPart(text=text)])
-        answer = self._call(template, self.llm, [*self.conversation, turn], schema, self.config.temperature)
+        while True:
+            opening = [TextPart(text=_section("faithful_feedback", "first"))] if len(self.conversation) == 1 and not self.summarised else []
+            turn = user_turn([*opening, *self.pending, TextPart(text=text)])
+            try:
+                answer = self._call(template, self.llm, [*self.conversation, turn], schema, self.config.temperature)
+                break
+            except ContextOverflowError:
+                if not self._summarise_oldest():
+                    raise
         if answer is not None:
             self.conversation += [turn, Message(role="assistant", content=answer.model_dump_json())]
+            self.feedback.append("\n".join(p.text for p in self.pending if isinstance(p, TextPart)))
             self.pending = []
         return answer
+
+    def _summarise_oldest(self) -> bool:
+        """Keep the conversation within the model's context: the oldest exchange (a user turn
+        and the answer to it) leaves the conversation and becomes one line of a summary in the
+        system turn — the feedback it carried and the preference and goals answered, without
+        the scene, the instructions and the model's reasoning. False when none is left."""
+        if len(self.conversation) < 3:
+            return False
+        answer = self.conversation[2].text
+        self.conversation = [self.conversation[0], *self.conversation[3:]]
+        feedback = self.feedback.pop(0) if self.feedback else ""
+        try:
+            data = json.loads(answer)
+        except ValueError:
+            data = {}
+        said = "; ".join(f"{k.replace('_', ' ')}: “{v}”" for k, v in data.items()
+                         if k in ("preference", "goal", "goal_a", "goal_b") or (k in ("blocks", "bowls") and v))
+        line = " ".join(x for x in (feedback.replace("\n", " "), f"You answered {said}." if said else "") if x)
+        self.summarised.append(line or "(an exchange without feedback)")
+        head = self.conversation[0].text.split(SUMMARY_HEAD)[0].rstrip()
+        lines = "\n".join(f"{i + 1}. {x}" for i, x in enumerate(self.summarised))
+        self.conversation[0] = Message(role="system", content=f"{head}\n\n{SUMMARY_HEAD}\n{lines}")
+        if self._final is not None:
+            self._final = None  # its exchange followed the old conversation
+        return True
 
     def drain_transcript(self) -> list[dict]:
         out, self.transcript = self.transcript, []
         return out
 
     def stats(self) -> dict:
-        return {"variant": self.variant, "turns": len(self.conversation)}
+        return {"variant": self.variant, "turns": len(self.conversation), "summarised": len(self.summarised)}
 
     # -- the round ---------------------------------------------------------------------------
     def design_scene(self) -> Scene | None:
@@ -217,7 +262,14 @@ class _FaithfulLearner(Learner):
             text = prompts.render("faithful_final", scene=self._table(scene, state))
             messages = [*self.conversation, user_turn([*self.pending, TextPart(text=text)])]
         self._final_note = None
-        answer = self._call("faithful_final", self.llm, messages, schema, self.config.temperature)
+        while True:
+            try:
+                answer = self._call("faithful_final", self.llm, messages, schema, self.config.temperature)
+                break
+            except ContextOverflowError:
+                if not self._summarise_oldest():
+                    raise
+                messages = [*self.conversation, messages[-1]]  # the test request stays as it was
         if answer is not None:
             self._final = (key, [messages[-1], Message(role="assistant", content=answer.model_dump_json())])
         return self._estimate(answer, 1, True)
@@ -245,6 +297,28 @@ class FaithfulPreferenceLearner(_FaithfulLearner):
     may_finish = True
     n_goals = 2
     round_template = "faithful_eq12"
+
+    max_reasks = 2  # asks again at most this often when goals A and B are the same
+
+    def estimate(self, scene: Scene, state: WorldState) -> Estimate:
+        """Eq. 1–2, asked again (in the same conversation) while A and B are one goal: two
+        identical showcases cannot be told apart, so the answer would carry nothing."""
+        self._scoring = False
+        text = prompts.render(self.round_template, scene=self._table(scene, state))
+        schema = faithful_answer_schema(self.n_goals, with_done=self.may_finish)
+        answer = self._converse(self.round_template, text, schema)
+        reasked = 0
+        while answer is not None and same_goal(answer.goal_a, answer.goal_b) and reasked < self.max_reasks:  # type: ignore[attr-defined]
+            reasked += 1
+            again = _section("faithful_feedback", "same_goals", a=answer.goal_a)  # type: ignore[attr-defined]
+            newer = self._converse(self.round_template, again, schema)
+            if newer is None:
+                break  # unusable: the answer we have stands
+            answer = newer
+        estimate = self._estimate(answer)
+        if reasked:
+            estimate.why["reasked_same_goals"] = reasked
+        return estimate
 
     def _feedback(self, record: RoundRecord, trajectories: list[Trajectory]) -> str | None:
         h = record.answer
