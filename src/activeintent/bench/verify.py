@@ -4,7 +4,7 @@ numbers cannot drift from the code silently. Before that, every line is checked 
 folder's plan and itself (bench/checks.py, cheap): a line that does not belong, or an episode
 recorded twice, fails the folder.
 
-Whole records are compared, except what describes the run rather than the episode: wall time
+Whole records are compared, except what describes the run rather than the episode: tokens spent, wall time
 and its split, provenance (commit, versions, CPU, date) and tracebacks. A folder written under
 an older record format, or one that says in ``NOT-VERIFIED.md`` why it cannot be re-run (e.g. it
 needs a model server), is refused, not reported as different.
@@ -21,7 +21,9 @@ import typer
 from activeintent.protocol import FORMAT_VERSION
 
 NOT_VERIFIED = "NOT-VERIFIED.md"  # a folder's own word on why it cannot be re-run
-NOT_COMPARED = frozenset({"wall_s", "time_split", "provenance", "traceback"})
+# Tokens describe what answering cost this run: a re-run whose answers come from the response
+# cache spends none (its model calls and answers are compared).
+NOT_COMPARED = frozenset({"wall_s", "time_split", "provenance", "traceback", "prompt_tokens", "completion_tokens"})
 # Record fields added after format 3 began: compared when the recorded episode has them (an
 # older record cannot differ in a field it never had; every field it has is compared).
 ADDED_IN_FORMAT_3 = frozenset({"diagnostics", "final_scene"})
