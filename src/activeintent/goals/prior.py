@@ -149,6 +149,11 @@ class FittedPrior:
             raise PriorError(f"{where}: not a prior file written by `prior fit` ({err})") from None
 
 
+def goal_bits(goal: Goal, prior: FittedPrior | None) -> float:
+    """L(z) under ``prior``; None is the length prior (the goal's own bits)."""
+    return goal.bits if prior is None else prior.bits(goal)
+
+
 def count(goals: Iterable[Goal]) -> dict[str, dict[str, int]]:
     tally: dict[str, Counter] = {}
     for g in goals:
@@ -161,10 +166,6 @@ def fit(goals: list[Goal], alpha: float, corpus: str = "") -> FittedPrior:
     if not alpha > 0:
         raise ValueError(f"the smoothing strength must be > 0 (got {alpha}): a goal nobody asked for stays possible")
     return FittedPrior(count(goals), alpha, corpus, len(goals))
-
-
-def mean_bits(prior: FittedPrior, goals: list[Goal]) -> float:
-    return float(np.mean([prior.bits(g) for g in goals]))
 
 
 def folds(n: int, k: int, seed: int = 0) -> list[np.ndarray]:
@@ -279,5 +280,5 @@ def _cached(text: str, where: str) -> FittedPrior:
     return got
 
 
-__all__ = ["ALPHAS", "FittedPrior", "PriorError", "choices_of", "choose_alpha", "choice_points", "fit",
+__all__ = ["ALPHAS", "FittedPrior", "PriorError", "choices_of", "choose_alpha", "choice_points", "fit", "goal_bits",
            "load_prior", "nested_cv", "read_corpus"]

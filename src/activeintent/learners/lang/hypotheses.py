@@ -21,7 +21,7 @@ import numpy as np
 from activeintent.goals import planner
 from activeintent.goals.facts import Facts, facts
 from activeintent.goals.language import Goal
-from activeintent.goals.prior import FittedPrior, load_prior
+from activeintent.goals.prior import FittedPrior, goal_bits, load_prior
 from activeintent.intentions.base import Intention
 from activeintent.learners.bayes.hypotheses import Hypothesis, random_scene
 from activeintent.learners.lang.space import Compiled, goal_space
@@ -90,7 +90,7 @@ class LangHypothesis(Hypothesis):
         self.space = space
         self.index = index
         self.clauses = ()
-        self.bits = goal.bits if space.prior is None else space.prior.bits(goal)
+        self.bits = goal_bits(goal, space.prior)
         self.name = goal.key
 
     @property

@@ -14,6 +14,7 @@ from pydantic import Field
 
 from activeintent.goals.facts import Facts, facts
 from activeintent.goals.language import Goal
+from activeintent.goals.prior import goal_bits
 from activeintent.learners.base import LearnerContext, Method, RoundRecord
 from activeintent.learners.bayes.judge import HypothesisJudge, trajectory_steps, utility
 from activeintent.learners.bayes.learner import BayesConfig, BayesLearner
@@ -141,7 +142,7 @@ class LangLearner(BayesLearner):
 
     def bits(self, goal: Goal) -> float:
         """L(z) under the learner's prior."""
-        return goal.bits if self.prior is None else self.prior.bits(goal)
+        return goal_bits(goal, self.prior)
 
     def _rejuvenate(self) -> int:
         if not self.config.rejuvenate_top:

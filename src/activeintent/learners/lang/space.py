@@ -38,7 +38,7 @@ from activeintent.goals.language import (
     structure_judge,
 )
 from activeintent.goals.planner import generic_moves, plan
-from activeintent.goals.prior import FittedPrior
+from activeintent.goals.prior import FittedPrior, goal_bits
 from activeintent.learners.bayes.hypotheses import random_scene
 from activeintent.world import WorldState, apply_skill, layout
 from activeintent.world.scene import kind_of
@@ -409,7 +409,7 @@ def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scen
     length = prior is None
 
     def bits(goal: Goal) -> float:
-        return goal.bits if length else prior.bits(goal)  # type: ignore[union-attr]
+        return goal_bits(goal, prior)
 
     clauses = sorted(all_clauses(), key=lambda c: (c.bits if length else bits(Goal((c,))), c.key))
     simple = sum(c.bits <= pair_bits for c in clauses)  # the pair pool's size under the length prior
