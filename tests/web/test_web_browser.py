@@ -463,6 +463,7 @@ def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
     assert row["condition"] == expected and row["study_id"] == "study42"
     assert row["button_order"] == " ".join(session.enrolment.button_order)
     assert row["final_scene_feasible"] == "true" and row["final_scene_index"] == "2"
+    assert row["final_video_watched"] == "ended" and float(row["final_video_server_seconds"]) >= 0  # the server's word
     assert row["round1_answer"] == "stop" and row["round1_viewing"] == "replay"
     assert row["round1_after_end_presses"] == "3" and row["round2_answer"] == "no_stop"
     assert float(row["round1_stop_time"]) == pytest.approx(target, abs=1e-3)

@@ -176,6 +176,9 @@ def good_body(rng: random.Random, endpoint: str) -> dict:
         # well formed, it is refused anyway (409) while the session is in progress
         return {"final_attempt": rng.choice(["yes", "partly", "no"]), "rule": rng.choice(["mine", "é\nx", "a" * 300]),
                 "comments": rng.choice([None, "ok"]), "client_ts": 1.7e9}
+    if endpoint == "final-video":
+        # well formed, it is refused anyway (409): the session has no final attempt yet
+        return {"event": rng.choice(["ready", "ended", "replay"]), "media_time": rng.choice([0, 1.5]), "client_ts": 1.7e9}
     if endpoint == "answer":
         # never the waiting round 1 when well formed: the session stays put (its answers are
         # the targeted and concurrent tests' business) and no episode runs during the fuzzing
@@ -251,6 +254,7 @@ def fuzz_path(rng: random.Random, sid: str, endpoint: str) -> str:
         "events": f"/api/sessions/{s}/events",
         "result": f"/api/sessions/{s}/result",
         "questionnaire": f"/api/sessions/{s}/questionnaire",
+        "final-video": f"/api/sessions/{s}/final-video",
         "files": f"/api/sessions/{s}/files/{name}",
         "other": rng.choice(["/", "/signal/preference", "/signal/stop", "/done", "/api/config", "/openapi.json",
                              "/static/style.css", "/static/%2e%2e/server.py", "/api", "/api/",
@@ -276,7 +280,7 @@ def test_random_malformed_requests_get_4xx_and_leave_only_valid_json(live_server
     seen: dict[int, int] = {}
     for i in range(FUZZ_REQUESTS):
         endpoint = rng.choice(["sessions", "state", "answer", "answer", "events", "events", "result",
-                               "questionnaire", "files", "files", "other"])
+                               "questionnaire", "final-video", "files", "files", "other"])
         method = rng.choice(METHODS)
         path = fuzz_path(rng, sid, endpoint)
         body = headers = None

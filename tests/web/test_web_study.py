@@ -200,7 +200,9 @@ def test_free_rule_session_questionnaire_and_guess_shown_always(live_server, htt
     summary = json.loads((folder / "summary.json").read_text())
     assert summary["success"] is None and summary["success_basis"] == "none" and summary["intention"] is None
     assert all(t["success"] is None for t in summary["tests"]) and set(summary["success_at"]) == {None}
-    assert httpx.get(f"{api}/sessions/{sid}/result").json() == summary
+    result = httpx.get(f"{api}/sessions/{sid}/result").json()  # the participant's view: no condition
+    assert result == {"budget": 2, "signals_used": 2, "rounds_used": summary["rounds_used"],
+                      "answers": summary["answers"], "design": "free-rule"}
     state = httpx.get(f"{api}/sessions/{sid}").json()
     assert state["success"] is None and state["success_basis"] == "none"
     assert state["estimate"]["answers"] == 2 and state["final_video"] and state["final_legend"]
@@ -212,6 +214,16 @@ def test_free_rule_session_questionnaire_and_guess_shown_always(live_server, htt
     presented = [e for e in events if e["type"] == "round_presented"]
     assert [e["estimate_shown"] for e in presented] == [False, True]  # what the participant saw, per round
     assert all(e["estimate"] and 0 <= e["confidence"] <= 1 for e in presented)
+
+    # the questions about the final attempt open only once the server saw its video end
+    unwatched = http.post(q, json={"final_attempt": "yes", "rule": "mine"})
+    assert unwatched.status_code == 409 and unwatched.json()["error"]["code"] == "final_video_not_watched"
+    assert not (folder / "questionnaire.json").exists()
+    final = f"{api}/sessions/{sid}/final-video"
+    assert http.post(final, json={"event": "replay"}).status_code == 409  # a replay only after the end
+    assert http.post(final, json={"event": "ready", "media_time": 0}).status_code == 200
+    viewing = http.post(final, json={"event": "ended", "media_time": 3.2}).json()["viewing"]
+    assert viewing["ended"] >= viewing["ready"] and viewing["replays"] == 0
 
     before = sorted(p.name for p in folder.iterdir())
     bad = [
@@ -236,6 +248,7 @@ def test_free_rule_session_questionnaire_and_guess_shown_always(live_server, htt
     saved = json.loads((folder / "questionnaire.json").read_text())
     assert saved["final_attempt"] == "partly" and saved["rule"] == "Blocks near bowls\nof their colour"
     assert saved["comments"] is None and saved["participant"] == "P-free" and saved["design"] == "free-rule"
+    assert saved["final_video_watched"] == "ended" and saved["final_video_server_seconds"] >= 0
     again = http.post(q, json={"final_attempt": "yes", "rule": "changed my mind"})
     assert again.status_code == 409 and again.json()["error"]["code"] == "already_submitted"
     assert json.loads((folder / "questionnaire.json").read_text()) == saved
@@ -261,6 +274,7 @@ def test_assigned_rule_is_shown_scored_and_exported_with_hidden_guesses(live_ser
     summary = json.loads((srv.session_dir(sid) / "summary.json").read_text())
     assert summary["success_basis"] == "assigned-rule" and summary["intention"] == "color-match"
     assert summary["success"] is None or 0 <= summary["success"] <= 1
+    http.post(f"{api}/sessions/{sid}/final-video", json={"event": "ended"}).raise_for_status()
     res = http.post(f"{api}/sessions/{sid}/questionnaire", json={"final_attempt": "no", "rule": "same colours"})
     assert res.status_code == 201
 

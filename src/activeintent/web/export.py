@@ -29,6 +29,7 @@ SESSION_COLUMNS = [
     "method", "signal", "show_estimate", "video_size", "seed", "rounds_planned", "rounds_answered",
     "signals_used", "answers", "answer_seconds_total", "session_seconds", "stalls_total", "stall_seconds_total", "success", "success_basis",
     "final_guess", "final_scene", "final_scene_index", "final_scene_feasible", "error", "final_video_watched", "final_video_seconds",
+    "final_video_server_seconds",
     "questionnaire_final_attempt", "questionnaire_rule", "questionnaire_comments",
     "questionnaire_submitted",
 ]
@@ -189,6 +190,7 @@ def session_record(folder: Path) -> dict:
         # whether the final attempt's video was watched before the questions opened, and how long
         "final_video_watched": questionnaire.get("final_video_watched"),
         "final_video_seconds": questionnaire.get("final_video_seconds"),
+        "final_video_server_seconds": questionnaire.get("final_video_server_seconds"),
         "questionnaire_final_attempt": questionnaire.get("final_attempt"),
         "questionnaire_rule": questionnaire.get("rule"),
         "questionnaire_comments": questionnaire.get("comments"),

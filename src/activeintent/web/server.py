@@ -115,6 +115,13 @@ class VideoReport(_Body):
     client_ts: float | None = _client_ts()
 
 
+class FinalVideoReport(_Body):
+    event: Literal["ready", "ended", "replay"] = Field(
+        description="ready: the final attempt starts; ended: it played to the end; replay: a replay starts")
+    media_time: float | None = Field(None, ge=0, le=1e5, allow_inf_nan=False)
+    client_ts: float | None = _client_ts()
+
+
 class ClientEvent(_Body):
     type: str = Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.:-]+$")
     client_ts: float = Field(ge=0, le=1e11, allow_inf_nan=False,
@@ -329,6 +336,15 @@ def config_view(config: StudyConfig, study: StudyFile | None, manager: SessionMa
     }
 
 
+# What a participant's browser may read of summary.json: never the method, the condition, the
+# intention or the learner's estimate (the researcher reads summary.json and study-export).
+PARTICIPANT_RESULT = ("budget", "signals_used", "rounds_used", "answers", "design")
+
+
+def participant_result(summary: dict) -> dict:
+    return {k: summary[k] for k in PARTICIPANT_RESULT if k in summary}
+
+
 def add_session_routes(app: FastAPI, manager: SessionManager, guard: SessionLimits) -> None:
     """The session API: start, state, answer, video events, UI events, questionnaire, result, files."""
 
@@ -386,6 +402,10 @@ def add_session_routes(app: FastAPI, manager: SessionManager, guard: SessionLimi
     def post_video(session: Owned, body: VideoReport) -> dict:
         return {"round": body.round, "viewing": session.video_event(body.round, body.event, body.media_time)}
 
+    @app.post("/api/sessions/{sid}/final-video", summary="The final attempt's video: ready, ended or a replay starts")
+    def post_final_video(session: Owned, body: FinalVideoReport) -> dict:
+        return {"viewing": session.final_video_event(body.event, body.media_time)}
+
     @app.post("/api/sessions/{sid}/events", summary="Append raw UI events (client timestamps kept)")
     def post_events(session: Owned, body: EventBatch) -> dict:
         events = [e.model_dump() for e in body.events]
@@ -401,12 +421,12 @@ def add_session_routes(app: FastAPI, manager: SessionManager, guard: SessionLimi
         own = ("final_attempt", "rule", "comments", "final_video_watched", "final_video_seconds", "submitted")
         return {"saved": True, "questionnaire": {k: record.get(k) for k in own}}
 
-    @app.get("/api/sessions/{sid}/result", summary="The episode's result (summary.json) once finished")
+    @app.get("/api/sessions/{sid}/result", summary="How the episode ended, once finished (summary.json stays on disk)")
     def get_result(sid: str) -> dict:
         session = session_or_404(sid)
         if session.result is None:
             raise ApiError(409, "no_result_yet", f"session {sid} is {session.status}; no result yet")
-        return session.result
+        return participant_result(session.result)
 
     @app.get("/api/sessions/{sid}/files/{name}", summary="A video of this session", response_class=FileResponse)
     def get_file(sid: str, name: str):

@@ -290,6 +290,7 @@ class WebSession:
         self.completion = completion
         # per round: when the first viewing was started (Ready) and ended, and replays after it
         self._viewing: dict[int, dict] = {}
+        self._final_viewing = {"ready": None, "ended": None, "replays": 0}  # the final attempt's video
         self.final_scene_index: int | None = None
         self.final_scene_feasible: bool | None = None
         self.dir = (config.out_dir / sid).resolve()
@@ -534,6 +535,23 @@ class WebSession:
         self.log_server(f"video_{event}", round=round, media_time=media_time, replays=out["replays"])
         return out
 
+    def final_video_event(self, event: str, media_time: float | None = None) -> dict:
+        """The final attempt's video: ``ready`` (it starts), ``ended`` (played to its end) or
+        ``replay``. The questionnaire opens only after ``ended`` (:meth:`submit_questionnaire`)."""
+        if not self.asks_final_attempt:
+            raise ApiError(409, "conflict", f"session {self.id} is {self.status}: there is no final attempt to watch")
+        with self._events_lock:
+            v = self._final_viewing
+            if event == "replay" and v["ended"] is None:
+                raise ApiError(409, "conflict", "a replay comes after the first viewing has ended")
+            if event in ("ready", "ended") and v[event] is None:
+                v[event] = time.time()
+            if event == "replay":
+                v["replays"] += 1
+            out = dict(v)
+        self.log_server(f"final_video_{event}", media_time=media_time, replays=out["replays"])
+        return out
+
     def guess_visible(self, guess: Guess | None) -> bool:
         # never the learner's prior: a guess is shown only once it rests on an answer
         return self.config.show_estimate != "hidden" and guess is not None and guess.answers >= 1
@@ -547,6 +565,15 @@ class WebSession:
         """Keep the participant's answers in ``questionnaire.json`` (once; after the episode)."""
         about = {"session": self.id, "participant": self.participant, "condition": self.enrolment.condition,
                  "design": self.config.design, "intention": self.config.intention_name}
+        if self.asks_final_attempt:
+            with self._events_lock:
+                viewed = dict(self._final_viewing)
+            if viewed["ended"] is None:
+                raise ApiError(409, "final_video_not_watched", f"session {self.id}: the questions about the final "
+                               "attempt open once its video has played to its end")
+            # what the server saw, in place of the page's own word
+            answers = {**answers, "final_video_watched": "replayed" if viewed["replays"] else "ended",
+                       "final_video_server_seconds": round(viewed["ended"] - (viewed["ready"] or viewed["ended"]), 3)}
         record = self.questionnaire.submit(answers, status=self.status, active=self.active,
                                            asks_final_attempt=self.asks_final_attempt, about=about, by=by)
         self.log_server("questionnaire_submitted", final_attempt=answers.get("final_attempt"),

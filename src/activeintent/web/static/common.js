@@ -224,6 +224,7 @@ const Study = (() => {
       "Please open the study link again to start afresh.",
     unknown_session: "This session does not exist any more (the server may have been restarted). " +
       "Please open the study link again.",
+    final_video_not_watched: "Please watch the robot's final attempt to its end first; the questions open after it.",
     after_video_end: "The video had already ended, so that Stop did not count. Choose another answer, or replay the video.",
   };
   function friendly(err, fallback = "Something went wrong. Please try again; if it keeps happening, contact the researchers.") {

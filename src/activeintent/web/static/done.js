@@ -30,18 +30,29 @@
     lastTime = t;
   });
   video.addEventListener("seeking", () => { lastTime = null; });
-  video.addEventListener("ended", () => {
+  // the server keeps its own record of the viewing: it opens the questions only after "ended"
+  const report = (event) => Study.api("POST", `/api/sessions/${Study.sessionId}/final-video`,
+    { event, media_time: video.currentTime, client_ts: Study.now() });
+  let started = false;
+  video.addEventListener("play", () => {
+    if (started) return;
+    started = true;
+    report("ready").catch(() => {});
+  });
+  video.addEventListener("ended", async () => {
     lastTime = null;
     if (!watch.ended) Study.log("final_watched", { seconds: watch.seconds });
     watch.ended = true;
     keepWatch();
     replayBtn.classList.remove("hidden");
+    try { await report("ended"); } catch (_) { /* the questionnaire's answer says so if it did not arrive */ }
     setLocked(false);
   });
   replayBtn.addEventListener("click", () => {
     if (document.getElementById("stage").classList.contains("gated")) return;
     watch.replays += 1;
     keepWatch();
+    report("replay").catch(() => {});
     Study.log("replay", { video: "final" });
     lastTime = null;
     video.currentTime = 0;
