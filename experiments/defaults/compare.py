@@ -1,0 +1,99 @@
+"""The defaults experiment's comparison: each (prior, scenes) arm against today's (length, sampled)
+on the same dev episodes, in area under success@k (k = 0..10), per signal; and the rule that
+picks the default. Run from the repository's root after run.sh:
+
+    .venv/bin/python experiments/defaults/compare.py [RESULTS_ROOT]
+
+RESULTS_ROOT holds dev-length-belief, dev-fitted-sampled and dev-fitted-belief (default:
+experiments/defaults/results); the baseline arm is docs/results/peer's lang-* dev episodes of
+trials 0-9. Writes RESULTS_ROOT/comparison.md and comparison.json.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from activeintent.bench.report import auc, paired_comparison, wilson
+from activeintent.results import read_results
+
+ARMS = ("length-sampled", "length-belief", "fitted-sampled", "fitted-belief")
+BASELINE = "length-sampled"
+LEARNERS = ("lang-stop", "lang-preference")
+TRIALS = 10
+
+
+def arm_records(root: Path) -> dict[str, list[dict]]:
+    """Every arm's records, methods named ``<method>@<arm>`` so that one list pairs them."""
+    dev = set(json.loads((root / "dev-fitted-belief" / "bench.json").read_text())["intentions"])
+    peer = [r for r in read_results(Path("docs/results/peer/results.jsonl"))
+            if r["method"] in LEARNERS and r["intention"] in dev and r["trial"] < TRIALS]
+    out = {BASELINE: peer}
+    for arm in ARMS[1:]:
+        out[arm] = list(read_results(root / f"dev-{arm}" / "results.jsonl"))
+    return out
+
+
+def summary(records: dict[str, list[dict]]) -> dict:
+    pooled = [{**r, "method": f"{r['method']}@{arm}"} for arm, rs in records.items() for r in rs]
+    rows = []
+    for arm, rs in records.items():
+        for method in (*LEARNERS, "lang-zero-signal"):
+            ok = [r for r in rs if r["method"] == method and r.get("success") is not None]
+            if not ok:
+                continue
+            mean = sum(r["success"] for r in ok) / len(ok)
+            lo, hi = wilson(mean * len(ok), len(ok))
+            areas = [a for a in (auc(r.get("success_at") or []) for r in ok) if a is not None]
+            answers = [sum(r.get("answers", {}).values()) for r in ok]
+            new_scene = [r.get("answers", {}).get("new_scene", 0) for r in ok]
+            rows.append({"arm": arm, "method": method, "n": len(ok), "success": mean, "lo": lo, "hi": hi,
+                         "area": sum(areas) / len(areas) if areas else None,
+                         "new_scene_share": sum(new_scene) / sum(answers) if sum(answers) else None})
+    paired = []
+    for arm in ARMS[1:]:
+        for method in LEARNERS:
+            c = paired_comparison(pooled, f"{method}@{arm}", f"{method}@{BASELINE}")
+            if c is not None:
+                paired.append({"arm": arm, "method": method, **c})
+    eligible = [arm for arm in ARMS[1:]
+                if all(p["mean"] >= 0 for p in paired if p["arm"] == arm)
+                and sum(p["arm"] == arm for p in paired) == len(LEARNERS)]
+    best = max(eligible, key=lambda arm: sum(p["mean"] for p in paired if p["arm"] == arm), default=None)
+    return {"rows": rows, "paired": paired, "eligible": eligible, "default": best or BASELINE}
+
+
+def markdown(s: dict) -> str:
+    lines = ["# Defaults on dev: prior × scenes", "",
+             "success@10, mean over episodes [95 % Wilson interval] (n = episodes); area: mean area under "
+             "success@k, k = 0..10; new scene: share of all answers.", "",
+             "| arm (prior-scenes) | method | success@10 | area | new scene |", "|---|---|---|---|---|"]
+    for r in s["rows"]:
+        area = "–" if r["area"] is None else f"{r['area']:.3f}"
+        share = "–" if r["new_scene_share"] is None else f"{100 * r['new_scene_share']:.0f} %"
+        lines.append(f"| {r['arm']} | {r['method']} | {r['success']:.2f} [{r['lo']:.2f}, {r['hi']:.2f}] "
+                     f"(n = {r['n']}) | {area} | {share} |")
+    lines += ["", f"Paired against {BASELINE} on the same (intention, trial): difference in area, mean "
+              "[95 % normal interval]; wins / ties / losses; success@10 difference [paired bootstrap].", "",
+              "| arm | method | Δ area | w / t / l | Δ success@10 |", "|---|---|---|---|---|"]
+    for p in s["paired"]:
+        lines.append(f"| {p['arm']} | {p['method']} | {p['mean']:+.3f} [{p['lo']:+.3f}, {p['hi']:+.3f}] "
+                     f"(n = {p['n']}) | {p['wins']} / {p['ties']} / {p['losses']} | "
+                     f"{p['final_mean']:+.3f} [{p['final_lo']:+.3f}, {p['final_hi']:+.3f}] |")
+    lines += ["", "Rule: an arm may become the default only if its paired mean is ≥ 0 for both signals; among "
+              "those, the highest mean of the two wins.", "",
+              f"Eligible: {', '.join(s['eligible']) or 'none'}. **Default: {s['default']}**.", ""]
+    return "\n".join(lines)
+
+
+def main() -> None:
+    root = Path(sys.argv[1]) if len(sys.argv) > 1 else Path("experiments/defaults/results")
+    s = summary(arm_records(root))
+    (root / "comparison.json").write_text(json.dumps(s, indent=1) + "\n")
+    (root / "comparison.md").write_text(markdown(s))
+    print(markdown(s))
+
+
+if __name__ == "__main__":
+    main()
