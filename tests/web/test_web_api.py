@@ -164,6 +164,16 @@ def test_stop_api_maps_times_and_rejects_times_outside_the_video(live_server, ht
     result = httpx.get(f"{api}/sessions/{sid}/result").json()
     assert result["signals_used"] == 1 and not {"method", "intention", "final_z", "seed"} & set(result)
     assert (folder / "final.webm").stat().st_size > 0 and (folder / "round1_y.webm").exists()
+    import imageio.v2 as iio
+
+    for name in ("round1_y", "final"):  # an H.264 MP4 beside each WebM, the same frames
+        mp4, webm = iio.get_reader(folder / f"{name}.mp4"), iio.get_reader(folder / f"{name}.webm")
+        assert mp4.get_meta_data()["codec"] == "h264"
+        assert mp4.count_frames() == webm.count_frames() and mp4.count_frames() >= 2
+    assert video["mp4_url"].endswith("/round1_y.mp4")
+    res = http.get(srv.url + video["mp4_url"])
+    assert res.status_code == 200 and res.headers["content-type"] == "video/mp4"
+    assert res.content == (folder / "round1_y.mp4").read_bytes()
 
     # a finished session takes no answers; its saved data stays as it is
     done = snapshot(folder)

@@ -112,6 +112,7 @@ def test_two_round_preference_session(live_server, page, tmp_path):
 
     wait_round(page, 2)
     assert page.inner_text("#progress .label") == "Round 2 of 2"
+    page.wait_for_selector("#ready:enabled")  # once both videos are loaded whole
     page.keyboard.press("Enter")  # the gate's key
     page.wait_for_selector('button[data-choice="cant_choose"]:enabled')
     page.click('button[data-choice="cant_choose"]')
@@ -301,7 +302,8 @@ def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server,
                 if (badge.classList.contains('hidden')) return;
                 const v = document.getElementById('video');
                 window.atStop = {question: !document.getElementById('question').classList.contains('hidden'),
-                                 paused: v.paused, time: v.currentTime, src: v.currentSrc,
+                                 paused: v.paused, time: v.currentTime, src: v.dataset.url,
+                                 blob: v.currentSrc.startsWith('blob:'),
                                  marker: !document.querySelector('#timeline .marker').classList.contains('hidden')};
                 obs.disconnect();
             }).observe(badge, {attributes: true});
@@ -311,6 +313,8 @@ def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server,
     page.wait_for_function("window.atStop !== undefined")
     at_stop = page.evaluate("window.atStop")
     assert at_stop["question"] and at_stop["paused"] and at_stop["marker"] and "round1_y" in at_stop["src"]
+    assert at_stop["blob"]  # it played from memory: fetched whole before Ready enabled
+    assert at_stop["src"].endswith(".mp4")  # H.264 where the browser plays it (Chromium does)
 
     page.wait_for_selector("#feedback:visible")  # round 2 is ready: first the guess, then the video
     assert not page.is_visible("#question")
@@ -338,6 +342,9 @@ def test_free_and_assigned_rule_sessions_end_with_the_questionnaire(live_server,
     assert row["questionnaire_final_attempt"] == "yes"
     assert row["questionnaire_rule"] == "Blocks into the bowl of their colour"
     assert row["questionnaire_comments"] is None and row["show_estimate"] == "after-answer"
+    loaded = [e for e in events(assigned.session_dir(sid)) if e["type"] == "videos_loaded"]
+    assert {1, None} <= {e["round"] for e in loaded}  # round 1's video and the final one, whole
+    assert all(b > 0 for e in loaded for b in e["data"]["bytes"])
 
 
 def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
@@ -388,6 +395,7 @@ def test_a_whole_assigned_rule_study_from_a_link(live_server, page, tmp_path):
     order = [page.get_attribute(f"#answers button:nth-child({i})", "data-action") for i in (1, 2)]
     assert order == session.enrolment.button_order
     assert page.evaluate("new Set([...document.querySelectorAll('#answers button')].map(b => b.className)).size") == 1
+    page.wait_for_selector("#ready:enabled")
     page.keyboard.press("Enter")  # Ready
     page.wait_for_selector('#question[data-phase="first"]')
     video = session_state(session)["question"]["videos"][0]

@@ -50,6 +50,10 @@ def layout_shot(page, tmp_path: Path, name: str) -> None:
         shutil.copy(path, DOCS_IMG / path.name)
 
 
+def events_of(folder) -> list[dict]:
+    return [json.loads(line) for line in (folder / "events.jsonl").read_text().splitlines()]
+
+
 def test_pages_fit_one_screen_at_common_sizes(live_server, browser, tmp_path):
     pref = live_server("bayes-preference", rounds=1, seed=3, **VIDEO)
     stop = live_server("bayes-stop", rounds=1, seed=4, **VIDEO)
@@ -207,16 +211,53 @@ def test_a_refused_start_reads_as_a_message_for_participants(live_server, page):
     assert page.is_enabled("#start")
 
 
-def test_a_stalled_video_is_recorded_per_round_and_exported(live_server, page, tmp_path):
-    """A throttled video route: round 1's video is held back until after Ready, so playback waits
-    for it (a stall at t = 0, as on a slow connection); the export has the stall and its length."""
+def test_ready_waits_for_the_whole_video_so_playback_cannot_stall(live_server, page, tmp_path):
+    """A slow video route: Ready stays disabled, showing how much has loaded, until the round's
+    video is in the page whole; after Ready it plays from memory (no stall)."""
     srv = live_server("bayes-stop", rounds=1, seed=4, video_size=(64, 64))
     held = []
+    page.route("**/files/round1_y.*", lambda r: held.append(r))  # answered later, by the test
+    enter(page, srv.url + "/", "P-slow")
+    page.click("#start")
+    page.wait_for_url("**/signal/stop?session=*")
+    sid = session_id(page)
+    wait_round(page, 1)
+    page.wait_for_timeout(1500)
+    assert held, "the video was never requested"
+    assert page.is_disabled("#ready") and page.inner_text("#ready").startswith("Loading")
+    for route in held:
+        route.fulfill(response=route.fetch())
+    page.unroute("**/files/round1_y.*")
+    page.wait_for_selector("#ready:enabled")
+    assert page.inner_text("#ready").startswith("Ready")
+    page.click("#ready")
+    page.wait_for_function("document.getElementById('video').currentTime > 0")
+    assert page.evaluate("document.getElementById('video').currentSrc").startswith("blob:")
+    page.click("#new-scene")
+    page.wait_for_url("**/done?session=*")
+    assert srv.manager.get(sid).join(60)
+    page.wait_for_timeout(1200)  # the page's event batch
+    (row,) = export(srv.out, tmp_path / "slow.csv")
+    assert int(row["round1_stalls"]) == 0, row
+    loaded = [e for e in events_of(srv.session_dir(sid)) if e["type"] == "videos_loaded" and e["round"] == 1]
+    assert loaded and loaded[0]["data"]["seconds"][0] >= 1.0  # the wait the participant saw, on record
 
-    def hold(route):
-        held.append(route)  # answered later, by the test: the video does not arrive yet
 
-    page.route("**/files/round1_y.webm", hold)
+def test_a_stalled_video_is_recorded_per_round_and_exported(live_server, page, tmp_path):
+    """When the whole-video load fails the page plays the video as it arrives; a throttled route
+    then holds it back until after Ready, so playback waits for it (a stall at t = 0, as on a
+    slow connection); the export has the stall and its length."""
+    srv = live_server("bayes-stop", rounds=1, seed=4, video_size=(64, 64))
+    seen, held = [], []
+
+    def route(r):
+        seen.append(r)
+        if len(seen) == 1:
+            r.abort()  # the whole-video load fails
+        else:
+            held.append(r)  # the streamed one: answered later, by the test
+
+    page.route("**/files/round1_y.*", route)
     enter(page, srv.url + "/", "P-stall")
     page.click("#start")
     page.wait_for_url("**/signal/stop?session=*")
@@ -225,10 +266,10 @@ def test_a_stalled_video_is_recorded_per_round_and_exported(live_server, page, t
     page.wait_for_selector("#ready:enabled")
     page.click("#ready")
     page.wait_for_timeout(1500)  # playback asked for, no frames: stalled
-    assert held, "the video was never requested"
-    for route in held:
-        route.fulfill(response=route.fetch())
-    page.unroute("**/files/round1_y.webm")
+    assert held, "the video was never requested as a stream"
+    for r in held:
+        r.fulfill(response=r.fetch())
+    page.unroute("**/files/round1_y.*")
     page.wait_for_function("document.getElementById('video').currentTime > 0")
     page.click("#new-scene")
     page.wait_for_url("**/done?session=*")
@@ -237,3 +278,4 @@ def test_a_stalled_video_is_recorded_per_round_and_exported(live_server, page, t
     page.wait_for_timeout(1200)  # the page's event batch
     (row,) = export(srv.out, tmp_path / "stall.csv")
     assert int(row["round1_stalls"]) >= 1 and float(row["round1_stall_s"]) >= 1.0, row
+    assert any(e["type"] == "videos_load_failed" and e["round"] == 1 for e in events_of(srv.session_dir(sid)))

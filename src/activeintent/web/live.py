@@ -40,7 +40,8 @@ class LiveExport:
         from activeintent.sim.video import export_video
 
         try:
-            export_video(traj, self.path, fps=fps, size=size, workers=workers)
+            # the MP4 from the same frames; the file is complete when both are
+            export_video(traj, self.path, fps=fps, size=size, workers=workers, also=(self.path.with_suffix(".mp4"),))
         except Exception as err:  # reported by wait_playable / finish, never lost in the thread
             self.error = f"{type(err).__name__}: {err}"
         finally:

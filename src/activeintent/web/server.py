@@ -439,8 +439,11 @@ def add_session_routes(app: FastAPI, manager: SessionManager, guard: SessionLimi
                 path = None
         if path is None:
             raise ApiError(404, "file_not_found", f"no file {name[:80]!r} in session {sid} "
-                           "(only its .webm/.gif videos are served)")
-        media = "video/webm" if path.suffix == ".webm" else "image/gif"
+                           "(only its .webm/.mp4/.gif videos are served)")
+        media = {".webm": "video/webm", ".mp4": "video/mp4"}.get(path.suffix, "image/gif")
+        if path.suffix == ".mp4" and session.live_export(path.with_suffix(".webm").name) is not None:
+            # an MP4 is whole only at the end (its index is written last): not sent half made
+            raise ApiError(409, "video_not_ready", f"{name} is still being drawn; it is complete with its .webm")
         live = session.live_export(name)
         if live is not None:  # still being drawn: sent as it grows (activeintent.web.live)
             return StreamingResponse(follow(live), media_type=media, headers={"Cache-Control": "no-store"})

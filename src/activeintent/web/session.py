@@ -49,7 +49,7 @@ from activeintent.web.videos import SessionVideos, VideoInfo
 SESSION_ID = re.compile(r"^[0-9a-f]{16}$")
 KEY_ID_CHARS = 16  # of the key's SHA-256: enough to tell browsers apart, useless to forge one
 # Only these files are ever served from a session folder.
-SERVED_FILE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*\.(webm|gif)$")
+SERVED_FILE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*\.(webm|mp4|gif)$")
 
 def signal_page(signal: str) -> str:
     """The path of a signal's answer page in the web app."""

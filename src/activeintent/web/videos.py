@@ -27,7 +27,8 @@ def video_duration(traj: Any, fps: int) -> float:
 
 class VideoInfo(BaseModel):
     label: str
-    url: str
+    url: str = Field(description="the WebM (VP9), playable while it is drawn")
+    mp4_url: str = Field(description="the same frames as H.264 MP4, complete with the WebM")
     file: str
     fps: int
     frames: int
@@ -47,6 +48,7 @@ class SessionVideos:
             label=label,
             file=f"{name}.webm",
             url=f"/api/sessions/{self.sid}/files/{name}.webm",
+            mp4_url=f"/api/sessions/{self.sid}/files/{name}.mp4",
             fps=self.fps,
             frames=video_frames(traj, self.fps),
             duration=video_duration(traj, self.fps),
@@ -57,7 +59,8 @@ class SessionVideos:
         """The whole video, written before this returns (the final attempt)."""
         from activeintent.sim.video import export_video
 
-        export_video(traj, self.dir / f"{name}.webm", fps=self.fps, size=self.size, workers=self.workers)
+        export_video(traj, self.dir / f"{name}.webm", fps=self.fps, size=self.size, workers=self.workers,
+                     also=(self.dir / f"{name}.mp4",))
         return self.info(traj, name, label)
 
     def finish(self) -> None:

@@ -70,8 +70,7 @@
       const which = v.label === "A" ? "first" : "second";
       Study.describeVideo(el, document.getElementById(`caption-${v.label.toLowerCase()}`),
         `Video ${v.label}: the robot's ${which} way of tidying this table`, q.legend, v.duration);
-      el.src = v.url;
-      el.load();
+      el.removeAttribute("src");
     }
     round = null;
     setEnabled(false);
@@ -81,13 +80,15 @@
     question.dataset.round = String(q.round);
     question.dataset.phase = "gate";
     Study.log("round_shown", { videos: q.videos.map((v) => v.url) }, q.round);
-    Study.readyGate(document.getElementById("gate"), q.round, () => {
+    const gate = document.getElementById("gate");
+    const loading = Study.loadForGate(gate, q.videos.map((v) => ({ video: videos[v.label], v })), q.round);
+    Study.readyGate(gate, q.round, () => {
       videosBox.classList.remove("gated");
       question.dataset.phase = "playing";
       for (const el of Object.values(videos)) el.play().catch(() => {});
       round = q.round;
       setEnabled(true);
-    });
+    }, loading);
   }
 
   Study.log("page_load", { page: "preference" });

@@ -169,8 +169,7 @@
     Study.describeVideo(video, document.getElementById("caption"), "The robot tidying this table", q.legend, v.duration);
     playBtn.classList.add("hidden");
     replayBtn.classList.add("hidden");
-    video.src = v.url;
-    video.load();
+    video.removeAttribute("src");
     round = q.round;
     endedAt = null;
     stage.classList.add("gated");
@@ -179,13 +178,15 @@
     question.dataset.round = String(q.round);
     status.textContent = "";
     Study.log("round_shown", { video: v.url, duration: v.duration, fps: v.fps }, q.round);
-    Study.readyGate(document.getElementById("gate"), q.round, () => {
+    const gate = document.getElementById("gate");
+    const loading = Study.loadForGate(gate, [{ video, v }], q.round);
+    Study.readyGate(gate, q.round, () => {
       stage.classList.remove("gated");
       setPhase("first");
       video.play().catch((err) => {
         if (err.name === "NotAllowedError") playBtn.classList.remove("hidden"); // autoplay blocked
       });
-    });
+    }, loading);
   }
 
   Study.log("page_load", { page: "stop" });

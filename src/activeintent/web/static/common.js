@@ -289,14 +289,95 @@ const Study = (() => {
     return false;
   }
 
-  // The ready gate before a video: nothing plays until the participant presses Ready (or Enter).
+  // A video fetched whole into memory before it may play: once it is on the page nothing can
+  // stall, and the stop time is read from a video that is all there. The server says when a file
+  // is written whole (the state's `complete`); until then this waits. onProgress(share) as it loads.
+  async function loadWhole(video, url, complete, onProgress) {
+    const started = now();
+    while (!(await complete())) await new Promise((r) => setTimeout(r, 250));
+    const res = await fetch(url, { credentials: "same-origin" });
+    if (!res.ok) throw new Error(`video ${url}: HTTP ${res.status}`);
+    const total = Number(res.headers.get("content-length")) || 0;
+    const parts = [];
+    let got = 0;
+    const reader = res.body.getReader();
+    for (;;) {
+      const { done, value } = await reader.read();
+      if (done) break;
+      parts.push(value);
+      got += value.length;
+      if (total) onProgress(Math.min(1, got / total));
+    }
+    const type = res.headers.get("content-type") || "video/webm";
+    if (video.dataset.blob) URL.revokeObjectURL(video.dataset.blob);
+    const blobUrl = URL.createObjectURL(new Blob(parts, { type }));
+    video.dataset.blob = blobUrl;
+    video.dataset.url = url; // which file it is (the element's own src is the blob)
+    const loaded = new Promise((resolve, reject) => {
+      video.addEventListener("loadeddata", resolve, { once: true });
+      video.addEventListener("error", () => reject(new Error(`video ${url} cannot be decoded`)), { once: true });
+    });
+    video.src = blobUrl;
+    video.load();
+    await loaded;
+    return { bytes: got, seconds: Math.round((now() - started) * 1000) / 1000 };
+  }
+
+  // Whether the video at `url` is written whole, from the session's state.
+  const isComplete = (url) => async () => {
+    const s = await api("GET", `/api/sessions/${sessionId}`);
+    const videos = [...((s.question && s.question.videos) || []), ...(s.final_video ? [s.final_video] : [])];
+    const v = videos.find((x) => x.url === url);
+    return !v || v.complete !== false;
+  };
+
+  // H.264 MP4 where the browser plays it (every common one, Safari included), else the WebM.
+  const H264 = 'video/mp4; codecs="avc1.42E01E"';
+  function pickUrl(video, v) {
+    return v.mp4_url && video.canPlayType(H264) ? v.mp4_url : v.url;
+  }
+
+  // Load every video of a gate whole (items: {video, v} with v the state's video), showing the
+  // share loaded on the gate's button.
+  async function loadForGate(gate, items, round) {
+    const button = gate.querySelector("button");
+    const label = button.firstChild;
+    const text = label.textContent;
+    const shares = items.map(() => 0);
+    const show = () => {
+      const pct = Math.round((100 * shares.reduce((a, b) => a + b, 0)) / items.length);
+      label.textContent = `Loading ${pct} %`;
+    };
+    show();
+    try {
+      const urls = items.map((it) => pickUrl(it.video, it.v));
+      const got = await Promise.all(items.map((it, i) => loadWhole(it.video, urls[i], isComplete(it.v.url),
+        (share) => { shares[i] = share; show(); })));
+      log("videos_loaded", { urls, bytes: got.map((g) => g.bytes), seconds: got.map((g) => g.seconds) }, round);
+    } catch (err) {
+      // the WebM played as it arrives instead: the stall log then says what the participant saw
+      log("videos_load_failed", { error: String(err && err.message) }, round);
+      for (const it of items) { it.video.src = it.v.url; it.video.dataset.url = it.v.url; it.video.load(); }
+    } finally {
+      label.textContent = text;
+    }
+  }
+
+  // The ready gate before a video: nothing plays until the participant presses Ready (or Enter),
+  // and Ready enables only once `loading` (the gate's videos, loaded whole) has settled.
   // onReady runs once; the gate logs how it was passed and tells the server (video "ready").
-  function readyGate(gate, round, onReady) {
+  function readyGate(gate, round, onReady, loading = Promise.resolve()) {
     const button = gate.querySelector("button");
     gate.classList.remove("hidden");
-    button.disabled = false;
-    button.focus();
+    button.disabled = true;
+    let open = false;
+    loading.finally(() => {
+      open = true;
+      button.disabled = false;
+      button.focus();
+    });
     const go = (via) => {
+      if (!open) return;
       button.onclick = null;
       document.removeEventListener("keydown", onKey, true);
       button.disabled = true;
@@ -339,6 +420,6 @@ const Study = (() => {
   return {
     sessionId, now, api, log, flush, goTo, poll, setProgress, fillGuess, setEstimate, setWaiting, showFatal,
     watchVideo, routeFinished, isTyping, setupLegend, fillLegend, describeVideo, betweenRounds,
-    readyGate, reportVideo, orderButtons, restart, friendly,
+    readyGate, loadForGate, reportVideo, orderButtons, restart, friendly,
   };
 })();

@@ -168,14 +168,15 @@
       Study.fillLegend(document.getElementById("legend-list"), s.final_legend);
       Study.describeVideo(video, document.getElementById("final-caption"),
         "The robot's final attempt on a new table", s.final_legend, s.final_video.duration);
-      video.src = s.final_video.url;
       document.getElementById("stage").classList.add("gated");
       replayBtn.classList.toggle("hidden", !watch.ended);
       setLocked(!watch.ended);
-      Study.readyGate(document.getElementById("gate"), null, () => {
+      const gate = document.getElementById("gate");
+      const loading = Study.loadForGate(gate, [{ video, v: s.final_video }], null);
+      Study.readyGate(gate, null, () => {
         document.getElementById("stage").classList.remove("gated");
         video.play().catch(() => {});
-      });
+      }, loading);
     } else {
       document.getElementById("final-card").classList.add("hidden");
     }
