@@ -129,7 +129,8 @@ class Episode:
     def ground(self, ask: Callable[[Scene, WorldState], Estimate], scene: Scene, state: WorldState
                ) -> tuple[Estimate, list[list[Skill]], list[str | None]]:
         """z, y from the learner and y turned into plans; y that cannot be grounded is sent back
-        ("I failed to generate the goal…") up to max_goal_retries times."""
+        ("I failed to generate the goal…") up to max_goal_retries times, and so are two
+        showcases that became one motion when the learner takes that back (``showcases_alike``)."""
         for attempt in range(self.protocol.max_goal_retries + 1):
             est = self.clock.timed("learner_s", ask, scene, state)
             if est.plans is not None:
@@ -140,10 +141,14 @@ class Episode:
                 plans.append(plan)
                 failures.append(failure)
             bad = [(g, f) for g, f in zip(est.goals, failures, strict=False) if f]
-            if not bad or attempt == self.protocol.max_goal_retries:
+            last = attempt == self.protocol.max_goal_retries
+            if bad and not last:
+                for goal, failure in bad:
+                    self.learner.execution_failed(goal, failure or "")
+                continue
+            alike = len(plans) == 2 and plans[0] == plans[1]
+            if not alike or last or not self.learner.showcases_alike(list(est.goals)):
                 return est, plans, failures
-            for goal, failure in bad:
-                self.learner.execution_failed(goal, failure or "")
         raise AssertionError("unreachable")
 
     def video(self, traj: Trajectory, name: str, stop_time: float | None = None) -> None:

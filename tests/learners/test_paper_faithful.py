@@ -430,3 +430,35 @@ def test_a_history_longer_than_the_context_is_summarised_oldest_first():
     assert 'preferred goal A ("tidy the blocks into bowls")' in system and "“matching colours”" in system
     assert "goal b: “build a tower”" in system
     assert len(model.calls[-1].messages) <= 5 and learner.stats()["summarised"] >= 2
+
+
+def test_showcases_that_become_one_motion_are_asked_again():
+    """Goals A and B worded differently but planned to the same motion: the episode tells the
+    learner and asks once more (max_goal_retries = 1); the round shows two different motions."""
+    from types import SimpleNamespace
+
+    from activeintent.episode import Episode
+
+    first = {"reasoning": "r", "preference": "p", "goal_a": "tidy the red one", "goal_b": "red block to its bowl",
+             "done": False}
+    second = {**first, "goal_a": "red block in the red bowl", "goal_b": "red block on the blue block"}
+    model = ScriptedModel([first, second], accepts_images=False)
+    learner = FaithfulPreferenceLearner(model, NO_DESIGN)
+    same = PutIn(block="red block", bowl="red bowl")
+    plans = {"tidy the red one": same, "red block to its bowl": same, "red block in the red bowl": same,
+             "red block on the blue block": PutOn(block="red block", target="blue block")}
+    episode = SimpleNamespace(clock=SimpleNamespace(timed=lambda name, f, *a: f(*a)),
+                              protocol=SimpleNamespace(max_goal_retries=1), learner=learner,
+                              _plan=lambda goal, st: ([plans[goal]], None))
+    est, got, failures = Episode.ground(episode, learner.estimate, SCENE, state())
+    assert est.goals == ["red block in the red bowl", "red block on the blue block"] and got[0] != got[1]
+    assert len(model.calls) == 2 and "made the robot do the same thing" in model.calls[1].messages[-1].text
+    assert learner.stats()["alike_reasks"] == 1 and failures == [None, None]
+
+    # a learner that does not take it back (the default) is not asked again
+    model = ScriptedModel([first, second], accepts_images=False)
+    learner = FaithfulPreferenceLearner(model, NO_DESIGN)
+    learner.showcases_alike = lambda goals: False
+    episode.learner = learner
+    est, got, _ = Episode.ground(episode, learner.estimate, SCENE, state())
+    assert est.goals == ["tidy the red one", "red block to its bowl"] and got[0] == got[1] and len(model.calls) == 1

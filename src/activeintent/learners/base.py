@@ -60,6 +60,12 @@ class Learner(ABC):
     def execution_failed(self, goal: str, reason: str) -> None:  # noqa: B027 - optional hook
         """The executor could not turn goal y into motion; the next estimate should be simpler."""
 
+    def showcases_alike(self, goals: list[str]) -> bool:
+        """The two showcases y^a, y^b became the same motion on this table, so an answer would
+        carry nothing. Return True when the learner was told and its next estimate may differ
+        (the episode then asks again, within max_goal_retries); by default it is not asked."""
+        return False
+
     def stats(self) -> dict:
         """Method-specific figures for the results."""
         return {}

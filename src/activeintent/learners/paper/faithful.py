@@ -299,6 +299,10 @@ class FaithfulPreferenceLearner(_FaithfulLearner):
     round_template = "faithful_eq12"
 
     max_reasks = 2  # asks again at most this often when goals A and B are the same
+    alike_reasks = 0  # rounds asked again because A and B became one motion
+
+    def stats(self) -> dict:
+        return {**super().stats(), "alike_reasks": self.alike_reasks}
 
     def estimate(self, scene: Scene, state: WorldState) -> Estimate:
         """Eq. 1–2, asked again (in the same conversation) while A and B are one goal: two
@@ -319,6 +323,12 @@ class FaithfulPreferenceLearner(_FaithfulLearner):
         if reasked:
             estimate.why["reasked_same_goals"] = reasked
         return estimate
+
+    def showcases_alike(self, goals: list[str]) -> bool:
+        a, b = (goals + ["", ""])[:2]
+        self.pending.append(TextPart(text=_section("faithful_feedback", "same_plans", a=a, b=b)))
+        self.alike_reasks += 1
+        return True
 
     def _feedback(self, record: RoundRecord, trajectories: list[Trajectory]) -> str | None:
         h = record.answer
