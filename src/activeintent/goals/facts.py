@@ -6,9 +6,9 @@ predicted state without recomputing geometry.
 
 from __future__ import annotations
 
-from collections import OrderedDict
 from dataclasses import dataclass, field
 
+from activeintent.memo import BoundedCache
 from activeintent.world import WorldState, relations
 from activeintent.world.colors import COOL_COLORS, WARM_COLORS
 from activeintent.world.scene import color_of
@@ -81,8 +81,8 @@ def state_key(f: Facts) -> tuple:
     return got
 
 
-_CACHE: OrderedDict[tuple, Facts] = OrderedDict()
-_CACHE_SIZE = 20000
+# by exact positions; Facts are a pure function of them
+_CACHE: BoundedCache[tuple, Facts] = BoundedCache(20000)
 
 
 def facts(state: WorldState) -> Facts:
@@ -90,7 +90,6 @@ def facts(state: WorldState) -> Facts:
     key = _key(state)
     hit = _CACHE.get(key)
     if hit is not None:
-        _CACHE.move_to_end(key)
         return hit
     rel = relations(state)
     blocks = tuple(state.blocks)
@@ -108,7 +107,4 @@ def facts(state: WorldState) -> Facts:
         cell=dict(rel.table_position),
         pos=dict(state.positions),
     )
-    _CACHE[key] = f
-    if len(_CACHE) > _CACHE_SIZE:
-        _CACHE.popitem(last=False)
-    return f
+    return _CACHE.put(key, f)

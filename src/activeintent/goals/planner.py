@@ -17,13 +17,13 @@ moves (deterministic, no clock), so "infeasible" means "not found within the bud
 
 from __future__ import annotations
 
-from collections import OrderedDict
 from collections.abc import Iterator
 
 import numpy as np
 
 from activeintent.goals.facts import Facts, facts
 from activeintent.goals.language import REGIONS, Goal, region_points
+from activeintent.memo import BoundedCache
 from activeintent.world import (
     PutAt,
     PutIn,
@@ -138,19 +138,12 @@ def run(state: WorldState, steps: list[Skill]) -> WorldState | None:
     return state
 
 
-_FEASIBLE: OrderedDict[tuple[str, tuple[str, ...]], bool] = OrderedDict()
-_FEASIBLE_SIZE = 200_000
+# by (goal, scene objects): a pure function of them (the layout is fixed by LAYOUT_SEED)
+_FEASIBLE: BoundedCache[tuple[str, tuple[str, ...]], bool] = BoundedCache(200_000)
 LAYOUT_SEED = 0
 
 
 def feasible(goal: Goal, scene: Scene) -> bool:
     """The planner finds a plan on the scene's layout (seed ``LAYOUT_SEED``); cached."""
-    key = (goal.key, tuple(scene.objects))
-    got = _FEASIBLE.get(key)
-    if got is None:
-        got = goal.possible(tuple(scene.objects)) and plan(
-            goal, WorldState(positions=layout(scene, LAYOUT_SEED))) is not None
-        _FEASIBLE[key] = got
-        if len(_FEASIBLE) > _FEASIBLE_SIZE:
-            _FEASIBLE.popitem(last=False)
-    return got
+    return _FEASIBLE.get_or_make((goal.key, tuple(scene.objects)), lambda: goal.possible(tuple(scene.objects)) and plan(
+        goal, WorldState(positions=layout(scene, LAYOUT_SEED))) is not None)

@@ -13,12 +13,12 @@ z-buffer over both would keep, at a third of the time.
 from __future__ import annotations
 
 import threading
-from collections import OrderedDict
 
 import numpy as np
 import pybullet as p
 import pybullet_data
 
+from activeintent.memo import BoundedCache
 from activeintent.sim.assets import color_panda, create_object, create_table, light_panda_urdf
 from activeintent.sim.robot import BASE_POSITION, BASE_YAW, REST_POSE
 from activeintent.world.state import WorldState
@@ -134,20 +134,14 @@ class SceneRenderer:
         return np.where((depth < table_depth)[:, :, None], rgb, table_rgb)
 
 
-_cache: OrderedDict[tuple[str, ...], SceneRenderer] = OrderedDict()
+# by the scene's objects in order; an evicted renderer's PyBullet client is closed
+_cache: BoundedCache[tuple[str, ...], SceneRenderer] = BoundedCache(_MAX_CACHED, on_evict=SceneRenderer.close)
 _HERE = threading.Lock()  # this process's PyBullet clients draw for one thread at a time
 
 
 def renderer_for(object_names: list[str]) -> SceneRenderer:
     """The cached renderer of a scene (least recently used ones are closed)."""
-    key = tuple(object_names)
-    if key in _cache:
-        _cache.move_to_end(key)
-        return _cache[key]
-    renderer = _cache[key] = SceneRenderer(list(object_names))
-    while len(_cache) > _MAX_CACHED:
-        _cache.popitem(last=False)[1].close()
-    return renderer
+    return _cache.get_or_make(tuple(object_names), lambda: SceneRenderer(list(object_names)))
 
 
 def _check_size(size: tuple[int, int]) -> tuple[int, int]:

@@ -19,6 +19,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from activeintent.intentions.base import Intention
+from activeintent.memo import BoundedCache
 from activeintent.registry import Registry
 from activeintent.signals import Answer, Signal, get_signal
 from activeintent.world import Scene, WorldState
@@ -32,7 +33,7 @@ class IntentionJudge:
 
     def __init__(self, intention: Intention):
         self.intention = intention
-        self._away: dict[tuple, bool] = {}
+        self._away: BoundedCache[tuple, bool] = BoundedCache(1024)  # by the step (states, skill, ok)
 
     def utility(self, state: WorldState) -> np.ndarray:
         score = float(np.clip(self.intention.score(state), 0.0, 1.0))
@@ -43,15 +44,9 @@ class IntentionJudge:
         made things worse (the score dropped, e.g. it knocked a tower over)."""
         key = (tuple(sorted(step.state_before.positions.items())), tuple(sorted(step.state_after.positions.items())),
                step.skill.model_dump_json(), step.ok)
-        if key not in self._away:
-            if len(self._away) > 1024:
-                self._away.clear()
-            if step.ok:
-                verdict = self.intention.step_moves_away(step.state_before, step.state_after, step.skill)
-            else:
-                verdict = self.intention.score(step.state_after) < self.intention.score(step.state_before) - 1e-9
-            self._away[key] = bool(verdict)
-        return self._away[key]
+        return self._away.get_or_make(key, lambda: bool(
+            self.intention.step_moves_away(step.state_before, step.state_after, step.skill) if step.ok
+            else self.intention.score(step.state_after) < self.intention.score(step.state_before) - 1e-9))
 
     def first_away(self, traj: Trajectory) -> np.ndarray:
         for step in traj.steps:

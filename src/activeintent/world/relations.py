@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pydantic import BaseModel
 
+from activeintent.memo import BoundedCache
 from activeintent.world.scene import (
     BLOCK_SIZE,
     BOUNDS,
@@ -54,19 +55,14 @@ def table_position_name(xy: tuple[float, float] | np.ndarray) -> str:
     return _GRID[row][col]
 
 
-_MEMO: dict[tuple, Relations] = {}  # planners and judges ask about the same states again and again
+# planners and judges ask about the same states again and again; by exact positions in order
+_MEMO: BoundedCache[tuple, Relations] = BoundedCache(50000)
 
 
 def relations(state: WorldState) -> Relations:
     """Compute relations from geometry (centres; blocks are 4 cm cubes). Memoised on the exact
     positions (in order): the result is shared, so callers must not change it."""
-    key = tuple(state.positions.items())
-    got = _MEMO.get(key)
-    if got is None:
-        if len(_MEMO) > 50000:
-            _MEMO.clear()
-        got = _MEMO[key] = _relations(state)
-    return got
+    return _MEMO.get_or_make(tuple(state.positions.items()), lambda: _relations(state))
 
 
 def _relations(state: WorldState) -> Relations:

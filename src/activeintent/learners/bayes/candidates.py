@@ -7,7 +7,6 @@ learner knows what τ it would show. Outcomes that end in the same state are kep
 
 from __future__ import annotations
 
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,6 +15,7 @@ from activeintent import ranking
 from activeintent.envs.symbolic import symbolic_trajectory
 from activeintent.goals.facts import facts, state_key
 from activeintent.learners.bayes.hypotheses import Hypothesis
+from activeintent.memo import BoundedCache
 from activeintent.world import Skill, WorldState
 from activeintent.world.skills import skill_key
 from activeintent.world.trajectory import Trajectory
@@ -35,19 +35,14 @@ class Outcome:
 
 # The final answers predict the same plans on the same test scenes after every signal, and
 # query selection revisits them: ≈ 60 % of predictions repeat within an episode.
-_PREDICTED: OrderedDict[tuple, Outcome] = OrderedDict()
-_PREDICTED_CAP = 8192
+_PREDICTED: BoundedCache[tuple, Outcome] = BoundedCache(8192)
 
 
 def predict(state: WorldState, plan: list[Skill]) -> Outcome:
     """``plan`` from ``state`` on the symbolic world model (kept by the exact positions, in
     order, and the skills: the same predicted τ, shared)."""
     key = (tuple(state.positions.items()), tuple(skill_key(s) for s in plan))
-    got = _PREDICTED.get(key)
-    if got is None:
-        got = _PREDICTED[key] = Outcome(list(plan), symbolic_trajectory(state.scene, state, plan))
-        if len(_PREDICTED) > _PREDICTED_CAP:
-            _PREDICTED.popitem(last=False)
+    got = _PREDICTED.get_or_make(key, lambda: Outcome(list(plan), symbolic_trajectory(state.scene, state, plan)))
     return Outcome(list(got.plan), got.traj)
 
 

@@ -102,7 +102,7 @@ def _explained(text: str) -> dict:
     from activeintent.bench.coverage import explain_intention
     from activeintent.intentions.registry import IntentionError
     from activeintent.learners.lang.explain import explain as explain_sentence
-    from activeintent.suites import HELDOUT_SUITES, resolve, suite_of
+    from activeintent.suites import is_held_out, resolve, suite_of
 
     name = text.strip()
     looks_like_name = ".py:" in name or (" " not in name and len(name) < 80)
@@ -114,7 +114,7 @@ def _explained(text: str) -> dict:
         if ".py:" in name:
             raise typer.BadParameter(str(err)) from None
         return explain_sentence(text)
-    if suite_of(name) in HELDOUT_SUITES:
+    if is_held_out(suite_of(name)):
         raise typer.BadParameter(f"{name!r} is held out: its coverage is reported only as the suite's mean "
                                  "(activeintent coverage --suite ...; per intention only after a freeze)")
     return explain_intention(intention)

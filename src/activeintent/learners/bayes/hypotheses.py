@@ -20,7 +20,6 @@ import hashlib
 import json
 import math
 import os
-from collections import OrderedDict
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
 from pathlib import Path
@@ -61,6 +60,7 @@ from activeintent.goals.recipes import (
     TwoStacks,
 )
 from activeintent.intentions.base import Intention
+from activeintent.memo import BoundedCache
 from activeintent.world import COLOR_NAMES, Scene, Skill, WorldState, layout, sample_scene
 
 SELECTORS = {
@@ -78,8 +78,7 @@ SUBJECTS = {
 _REGION, _CELL = InRegion(), InCell()
 # Hypothesis.plans by (z, variants, positions); a hypothesis hashes by identity, so a key
 # keeps its z alive and never matches another one.
-_PLANS: OrderedDict[tuple, list[list[Skill]]] = OrderedDict()
-_PLANS_SIZE = 30000
+_PLANS: BoundedCache[tuple, list[list[Skill]]] = BoundedCache(30000)
 REGIONS = {
     "top left corner": (_REGION, "back left corner"), "top side": (_CELL, "top side"),
     "top right corner": (_REGION, "back right corner"), "left side": (_CELL, "left side"),
@@ -238,12 +237,7 @@ class Hypothesis(Intention):
         change the lists."""
         n = variants or max(c.leaf.variants for c in self.clauses)
         key = (self, n, tuple(state.positions.items()))
-        out = _PLANS.get(key)
-        if out is None:
-            out = _PLANS[key] = self._plans(state, n)
-            if len(_PLANS) > _PLANS_SIZE:
-                _PLANS.popitem(last=False)
-        return out
+        return _PLANS.get_or_make(key, lambda: self._plans(state, n))
 
     def _plans(self, state: WorldState, n: int) -> list[list[Skill]]:
         out: list[list[Skill]] = []

@@ -8,6 +8,7 @@ import numpy as np
 
 from activeintent.goals.facts import Facts, facts
 from activeintent.learners.bayes.hypotheses import Hypothesis
+from activeintent.memo import BoundedCache, IdentityCache
 from activeintent.world import WorldState
 from activeintent.world.trajectory import Trajectory
 
@@ -75,16 +76,12 @@ def _judged_by_clauses(h: Hypothesis) -> bool:
             and t.moved_off is Hypothesis.moved_off and t.feasible is Hypothesis.feasible and bool(h.clauses))
 
 
-_COMPILED: dict[object, _Clauses] = {}
+# by the hypothesis set's token (one per set of hypotheses)
+_COMPILED: BoundedCache[object, _Clauses] = BoundedCache(64)
 
 
 def _compiled(hyps: tuple[Hypothesis, ...], token: object) -> _Clauses:
-    got = _COMPILED.get(token)
-    if got is None:
-        if len(_COMPILED) > 64:
-            _COMPILED.clear()
-        got = _COMPILED[token] = _Clauses(hyps)
-    return got
+    return _COMPILED.get_or_make(token, lambda: _Clauses(hyps))
 
 
 def judge(hyps: tuple[Hypothesis, ...], f: Facts, token: object = None) -> tuple[np.ndarray, np.ndarray]:
@@ -151,8 +148,8 @@ class HypothesisJudge:
         self.hyps = hyps
         self.size = len(hyps)
         self.token = next(_TOKENS)
-        self._away: dict[int, tuple[Trajectory, np.ndarray]] = {}
-        self._feasible: dict[tuple[str, ...], np.ndarray] = {}
+        self._away: IdentityCache[np.ndarray] = IdentityCache(4096)  # per τ shown
+        self._feasible: BoundedCache[tuple[str, ...], np.ndarray] = BoundedCache(4096)  # per scene's objects
         # hypotheses that judge in batches (model-proposed code); the others' prefetch does nothing
         self._batched = [h for h in hyps if type(h).prefetch is not Hypothesis.prefetch]
 
@@ -169,9 +166,7 @@ class HypothesisJudge:
             got[comp.grammar] = comp.feasible(tuple(scene.objects), scene.blocks)
             for i in comp.own:
                 got[i] = self.hyps[i].feasible(scene)
-            if len(self._feasible) > 4096:
-                self._feasible.clear()
-            self._feasible[key] = got
+            self._feasible.put(key, got)
         return got
 
     def prefetch(self, states: list[Facts]) -> None:
@@ -197,14 +192,10 @@ class HypothesisJudge:
         return first_away(self.hyps, [(fb, fa, block, ok)], self.token) == 0
 
     def first_away(self, traj: Trajectory) -> np.ndarray:
-        hit = self._away.get(id(traj))
-        if hit is not None and hit[0] is traj:
-            return hit[1]
+        return self._away.get_or_make(traj, lambda: self._first_away(traj))
+
+    def _first_away(self, traj: Trajectory) -> np.ndarray:
         steps = trajectory_steps(traj)
         for h in self._batched:
             h.prefetch([f for st in steps for f in st[:2]])
-        away = first_away(self.hyps, steps, self.token)
-        if len(self._away) > 4096:
-            self._away.clear()
-        self._away[id(traj)] = (traj, away)  # keeps τ alive so its id is not reused
-        return away
+        return first_away(self.hyps, steps, self.token)

@@ -14,8 +14,6 @@ verdict: a scene in which the planner failed is infeasible from then on.
 
 from __future__ import annotations
 
-from collections import OrderedDict
-
 import numpy as np
 
 from activeintent.goals import planner
@@ -25,6 +23,7 @@ from activeintent.goals.prior import FittedPrior, goal_bits, load_prior
 from activeintent.intentions.base import Intention
 from activeintent.learners.bayes.hypotheses import Hypothesis, random_scene
 from activeintent.learners.lang.space import Compiled, goal_space
+from activeintent.memo import BoundedCache
 from activeintent.world import Scene, Skill, WorldState
 
 
@@ -38,7 +37,8 @@ class LangSpace:
         self.variants = variants
         self.failed: dict[tuple[str, ...], set[int]] = {}
         self._feasible: dict[tuple[str, ...], tuple[int, np.ndarray]] = {}
-        self._plans: OrderedDict[tuple, list[list[Skill]]] = OrderedDict()
+        # by (goal, variants, exact positions): plans are a pure function of them, shared by episodes
+        self._plans: BoundedCache[tuple, list[list[Skill]]] = BoundedCache(20000)
         self.hypotheses = tuple(LangHypothesis(g, self, i) for i, g in enumerate(self.goals))
 
     def feasible(self, objects: tuple[str, ...]) -> np.ndarray:
@@ -74,9 +74,7 @@ class LangSpace:
                 if k not in seen:
                     seen.add(k)
                     out.append(p)
-            self._plans[key] = out
-            if len(self._plans) > 20000:
-                self._plans.popitem(last=False)
+            self._plans.put(key, out)
         if not out:  # the planner found no plan: infeasible in this scene from now on (this episode)
             self.failed.setdefault(tuple(state.scene.objects), set()).add(i)
         return out

@@ -66,9 +66,9 @@ class LangJudge(HypothesisJudge):
         return away
 
     def first_away(self, traj: Trajectory) -> np.ndarray:
-        hit = self._away.get(id(traj))
-        if hit is not None and hit[0] is traj:
-            return hit[1]
+        return self._away.get_or_make(traj, lambda: self._first_away(traj))
+
+    def _first_away(self, traj: Trajectory) -> np.ndarray:
         out = np.full(self.size, -1)
         for k, (fb, fa, block, ok) in enumerate(trajectory_steps(traj)):
             if fb is fa:
@@ -76,9 +76,6 @@ class LangJudge(HypothesisJudge):
             out[(out < 0) & self.step_away(fb, fa, block, ok)] = k
             if (out >= 0).all():
                 break
-        if len(self._away) > 4096:
-            self._away.clear()
-        self._away[id(traj)] = (traj, out)  # keeps τ alive so its id is not reused
         return out
 
 

@@ -40,6 +40,7 @@ from activeintent.goals.language import (
 from activeintent.goals.planner import generic_moves, plan
 from activeintent.goals.prior import FittedPrior, goal_bits
 from activeintent.learners.bayes.hypotheses import random_scene
+from activeintent.memo import BoundedCache
 from activeintent.world import WorldState, apply_skill, layout
 from activeintent.world.scene import kind_of
 
@@ -110,8 +111,8 @@ class Compiled:
         self._f_index = np.array(self.forms, int)
         self._f_sel = np.array(self.f_sel, int)
         self._f_shape = np.array(self.f_shape, int)
-        self._possible: dict[tuple[str, ...], np.ndarray] = {}
-        self._selected: dict[tuple, np.ndarray] = {}
+        self._possible: BoundedCache[tuple[str, ...], np.ndarray] = BoundedCache(4096)  # per scene's objects
+        self._selected: BoundedCache[tuple, np.ndarray] = BoundedCache(4096)  # per (blocks, bowls)
         self._tag = ("lang", next(_TOKENS))  # unique per judge (an id() can be reused)
 
     # -- per state --
@@ -129,9 +130,7 @@ class Compiled:
             S = np.array([[NODES["selector"][s].pick(b, bowls, p) for b in blocks] for s, p in self.sels], bool)
             S = S.reshape(len(self.sels), len(blocks))
             S.flags.writeable = False  # shared by every state of the scene
-            if len(self._selected) > 4096:
-                self._selected.clear()
-            self._selected[(blocks, bowls)] = S
+            self._selected.put((blocks, bowls), S)
         R = np.zeros((len(self.rels), len(blocks)), bool)
         X = np.zeros_like(R)
         for j, (r, p) in enumerate(self.rels):
@@ -307,9 +306,7 @@ class Compiled:
         if got is None:
             memo: dict = {}  # the clauses share their groups and relation checks in this scene
             c = np.array([cl.possible(key, memo) for cl in self.clauses] + [True], bool)
-            got = self._possible[key] = c[self.E].all(1)
-            if len(self._possible) > 4096:
-                self._possible.clear()
+            got = self._possible.put(key, c[self.E].all(1))
         return got
 
 
