@@ -5,12 +5,15 @@ written blind with the world's helpers only, in ``intentions/suites/heldout2.py`
 separately, like ``heldout``), ``dev`` (``intentions/suites/dev.py``: for tuning learners) and
 ``truth-goals`` (``truth-00`` … ``truth-49``: 50 goals of the goal language drawn at random and
 committed as data, ``bench/truth_goals.json``; learning efficiency apart from coverage).
-Names of every suite resolve everywhere an intention name is accepted.
+Names of every suite resolve everywhere an intention name is accepted. Suites are the registry
+:data:`SUITES`; a plug-in file adds its own (``SUITES.register("mine", Suite(load=...))``).
 """
 
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
+from dataclasses import dataclass
 
 from activeintent.intentions.base import Intention
 from activeintent.intentions.registry import (
@@ -21,9 +24,25 @@ from activeintent.intentions.registry import (
     get_intention,
     resolve_intention,
 )
+from activeintent.registry import Registry, UnknownName
 
-SUITE_NAMES = ("paper", "library", "heldout", "heldout2", "dev", "truth-goals")
-HELDOUT_SUITES = ("heldout", "heldout2")  # written blind; never tuned on; per intention only after a freeze
+
+@dataclass(frozen=True)
+class Suite:
+    """A named set of hidden intentions. ``load`` makes them (name → Intention; imported on
+    first use), ``held_out``: written blind, never tuned on, reported per intention only after
+    a freeze (docs/results/HELDOUT_RUNS.md)."""
+
+    load: Callable[[], dict[str, Intention]]
+    held_out: bool = False
+
+
+def _paper() -> dict[str, Intention]:
+    return {n: get_intention(n) for n in PAPER_INTENTIONS}
+
+
+def _library() -> dict[str, Intention]:
+    return {n: get_intention(n) for n in INTENTION_NAMES if n not in PAPER_INTENTIONS}
 
 
 def _heldout() -> dict[str, Intention]:
@@ -38,11 +57,6 @@ def _heldout2() -> dict[str, Intention]:
     return {it.name: it for it in heldout2_intentions()}
 
 
-@functools.cache
-def _heldout2_names() -> frozenset[str]:
-    return frozenset(_heldout2())
-
-
 def _dev() -> dict[str, Intention]:
     from activeintent.intentions.suites.dev import dev_intentions
 
@@ -55,67 +69,71 @@ def _truth() -> dict[str, Intention]:
     return {it.name: it for it in truth_intentions()}
 
 
-def _truth_names() -> list[str]:
-    from activeintent.bench.truth_goals import truth_names
+# The suites, in the order they are listed and searched; a plug-in adds its own with
+# SUITES.register("name", Suite(load=...)).
+SUITES: Registry[Suite] = Registry("suite")
+SUITES.register("paper", Suite(_paper), help="the paper's four intentions")
+SUITES.register("library", Suite(_library), help="the other built-in intentions")
+SUITES.register("heldout", Suite(_heldout, held_out=True), help="written blind before any learner change")
+SUITES.register("heldout2", Suite(_heldout2, held_out=True), help="a second blind suite, the world's helpers only")
+SUITES.register("dev", Suite(_dev), help="for developing learners")
+SUITES.register("truth-goals", Suite(_truth), help="50 goals of the goal language drawn at random")
 
-    return truth_names()
+SUITE_NAMES = tuple(SUITES.names())  # the built-in ones
+HELDOUT_SUITES = tuple(n for n in SUITE_NAMES if SUITES[n].held_out)  # written blind; never tuned on
+
+
+def is_held_out(suite_name: str) -> bool:
+    return suite_name in SUITES and SUITES[suite_name].held_out
+
+
+@functools.cache
+def _names(suite_name: str) -> tuple[str, ...]:
+    return tuple(SUITES[suite_name].load())
 
 
 def suite(name: str) -> list[str]:
-    """Intention names of a suite."""
-    if name == "paper":
-        return list(PAPER_INTENTIONS)
-    if name == "library":
-        return [n for n in INTENTION_NAMES if n not in PAPER_INTENTIONS]
-    if name == "heldout":
-        return list(_heldout())
-    if name == "heldout2":
-        return list(_heldout2())
-    if name == "dev":
-        return list(_dev())
-    if name == "truth-goals":
-        return _truth_names()
-    raise ValueError(f"Unknown suite {name!r}; valid suites: {', '.join(SUITE_NAMES)}.")
+    """Intention names of a suite (unknown names list the valid ones)."""
+    try:
+        SUITES.check(name)
+    except UnknownName as err:
+        raise ValueError(str(err)) from None
+    if name in ("paper", "library"):  # the intention registry can grow (plug-ins): not cached
+        return list(SUITES[name].load())
+    return list(_names(name))
 
 
 def suite_of(intention: str) -> str:
-    """The suite an intention name belongs to ('file' for path.py:NAME)."""
+    """The suite an intention name belongs to: 'file' for path.py:NAME, 'plugin' for one a
+    plug-in file registered, 'other' for a name no suite holds."""
     if ".py:" in intention:
         return "file"
     if intention in PAPER_INTENTIONS:
         return "paper"
     if intention in INTENTION_NAMES:
         return "library"
-    if intention in INTENTIONS:  # registered by a plug-in file
+    if intention in INTENTIONS:
         return "plugin"
-    if intention.startswith("truth-") and intention in _truth_names():
-        return "truth-goals"
-    if intention in _heldout2_names():
-        return "heldout2"
-    return "dev" if intention in _dev() else "heldout"
+    for name in SUITES:
+        if name not in ("paper", "library") and intention in _names(name):
+            return name
+    return "other"
 
 
 def resolve(name: str | None, intention_file: str | None = None) -> Intention:
     """``--intention NAME`` (any suite) or ``--intention-file path.py:NAME``."""
     if name and not intention_file and name not in INTENTIONS:
-        dev = _dev()
-        if name in dev:
-            return dev[name]
-        held = _heldout()
-        if name in held:
-            return held[name]
-        held2 = _heldout2()
-        if name in held2:
-            return held2[name]
-        truth = _truth()
-        if name in truth:
-            return truth[name]
+        for suite_name in SUITES:
+            if suite_name not in ("paper", "library") and name in _names(suite_name):
+                return SUITES[suite_name].load()[name]
         try:
             return get_intention(name)
         except IntentionError as err:
-            raise IntentionError(
-                f"{err} Held-out intentions: {', '.join(held)}. Held-out-2 intentions: "
-                f"{', '.join(held2)}. Dev intentions: {', '.join(dev)}. "
-                f"Truth-goal intentions: {_truth_names()[0]} … {_truth_names()[-1]}."
-            ) from None
+            others = "; ".join(f"{n}: {_listed(n)}" for n in SUITES if n not in ("paper", "library"))
+            raise IntentionError(f"{err} Intentions of the other suites — {others}.") from None
     return resolve_intention(name, intention_file)
+
+
+def _listed(suite_name: str) -> str:
+    names = _names(suite_name)
+    return ", ".join(names) if len(names) <= 20 else f"{names[0]} … {names[-1]} ({len(names)})"

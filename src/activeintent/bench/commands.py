@@ -255,7 +255,7 @@ def coverage(
 
     from activeintent.bench.coverage import EXPRESSIBLE, coverage_table
     from activeintent.progress_lines import print_line
-    from activeintent.suites import HELDOUT_SUITES, resolve, suite_of
+    from activeintent.suites import is_held_out, resolve, suite_of
     from activeintent.suites import suite as suite_names
 
     console = Console()
@@ -276,7 +276,7 @@ def coverage(
         from activeintent.bench.coverage import agreement
         from activeintent.goals.language import parse_goal
 
-        if any(g in HELDOUT_SUITES for g in groups) and not after_freeze:
+        if any(is_held_out(g) for g in groups) and not after_freeze:
             console.print("[red]error:[/red] held-out intentions are read only after a freeze (--after-freeze)")
             raise typer.Exit(2)
         try:
@@ -296,7 +296,7 @@ def coverage(
     table = coverage_table(items, groups, seed=seed, scenes=scenes, test_scenes=test_scenes,
                            progress=lambda text: print_line(console, escape(text)) if not as_json else None)
     if not after_freeze:  # per-intention rows of a held-out suite are the reading its rule forbids
-        table["intentions"] = [r for r in table["intentions"] if r["suite"] not in HELDOUT_SUITES]
+        table["intentions"] = [r for r in table["intentions"] if not is_held_out(r["suite"])]
     if out is not None:
         out.parent.mkdir(parents=True, exist_ok=True)
         out.write_text(json.dumps(table, indent=2, ensure_ascii=False))
@@ -315,6 +315,6 @@ def coverage(
                       f"(95 % bootstrap interval {s['ci'][0]:.2f}–{s['ci'][1]:.2f}); {s['expressible']} of {s['n']} "
                       f"≥ {EXPRESSIBLE}; median L(z*) {s['median_bits']:.1f} bits; {s['in_start_space']} in the start space",
                       highlight=False)
-    hidden = sorted({g for g in groups if g in HELDOUT_SUITES})
+    hidden = sorted({g for g in groups if is_held_out(g)})
     if hidden and not after_freeze:
         console.print(f"(per-intention rows of {', '.join(hidden)} not shown: held out; --after-freeze shows them)")

@@ -42,7 +42,7 @@ from activeintent.goals.planner import generic_moves, plan
 from activeintent.intentions.base import Intention
 from activeintent.learners.lang.space import Compiled
 from activeintent.protocol import sample_test_scene, stable_seed
-from activeintent.suites import HELDOUT_SUITES
+from activeintent.suites import is_held_out
 from activeintent.world import Scene, WorldState, apply_skill, layout
 
 SELECTION_SCENES = 30
@@ -282,7 +282,7 @@ def coverage_table(intentions: list[Intention], suites: list[str], seed: int = 0
         c = coverage(it, seed=seed, scenes=scenes, test_scenes=test_scenes, start_keys=keys)
         rows.append({"suite": group, **c.row()})
         if progress:
-            progress(f"{k}/{len(intentions)} {group}: {'(held out)' if group in HELDOUT_SUITES else it.name} done")
+            progress(f"{k}/{len(intentions)} {group}: {'(held out)' if is_held_out(group) else it.name} done")
     out = []
     for group in dict.fromkeys(suites):
         got = [r for r in rows if r["suite"] == group]

@@ -371,11 +371,11 @@ def _oracle_row(oracle: dict[str, dict] | None, suite: str, names: list[str], wi
     if oracle is None:
         return ["| *oracle* (best goal of the goal language) | " + " | ".join("–" for _ in names)
                 + " | not measured (`bench --no-oracle`) | | | | | | |"]
-    from activeintent.suites import HELDOUT_SUITES
+    from activeintent.suites import is_held_out
 
     got = [oracle[i]["success"] for i in names if i in oracle]
     n = oracle[names[0]]["test_scenes"] if names and names[0] in oracle else 0
-    cells = ["held out" if suite in HELDOUT_SUITES else (f"{oracle[i]['success']:.2f}" if i in oracle else "–")
+    cells = ["held out" if is_held_out(suite) else (f"{oracle[i]['success']:.2f}" if i in oracle else "–")
              for i in names]
     mean = f"**{np.mean(got):.2f}** (mean of {len(got)}; plan success on {n} scenes each)" if got else "–"
     return ["| *oracle* (best goal of the goal language: the ceiling of lang-* / decide-*) | " + " | ".join(cells)
