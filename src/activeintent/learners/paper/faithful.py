@@ -65,6 +65,9 @@ SUMMARY_HEAD = ("Earlier rounds, in short (the whole conversation no longer fits
                 "what the person's answers said and what you answered):")
 TEMPLATES = ("faithful_x", "faithful_scene", "faithful_eq12", "faithful_eq3", "faithful_eq4", "faithful_eq56",
              "faithful_final", "faithful_failed", "faithful_feedback")
+# Not in TEMPLATES (whose hash versions every cached answer): a template added later leaves the
+# recorded caches of the others usable; its own text is in the messages, which the key covers.
+LATER_TEMPLATES = ("faithful_same_plans",)
 
 
 class FaithfulConfig(PaperLearnerConfig):
@@ -326,7 +329,7 @@ class FaithfulPreferenceLearner(_FaithfulLearner):
 
     def showcases_alike(self, goals: list[str]) -> bool:
         a, b = (goals + ["", ""])[:2]
-        self.pending.append(TextPart(text=_section("faithful_feedback", "same_plans", a=a, b=b)))
+        self.pending.append(TextPart(text=prompts.render("faithful_same_plans", a=a, b=b)))
         self.alike_reasks += 1
         return True
 
