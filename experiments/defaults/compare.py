@@ -18,6 +18,7 @@ from pathlib import Path
 from activeintent.bench.report import auc, paired_comparison, wilson
 from activeintent.results import read_results
 
+REPO = Path(__file__).resolve().parents[2]
 ARMS = ("length-sampled", "length-belief", "fitted-sampled", "fitted-belief")
 BASELINE = "length-sampled"
 LEARNERS = ("lang-stop", "lang-preference")
@@ -27,7 +28,7 @@ TRIALS = 10
 def arm_records(root: Path) -> dict[str, list[dict]]:
     """Every arm's records, methods named ``<method>@<arm>`` so that one list pairs them."""
     dev = set(json.loads((root / "dev-fitted-belief" / "bench.json").read_text())["intentions"])
-    peer = [r for r in read_results(Path("docs/results/peer/results.jsonl"))
+    peer = [r for r in read_results(REPO / "docs" / "results" / "peer" / "results.jsonl")
             if r["method"] in LEARNERS and r["intention"] in dev and r["trial"] < TRIALS]
     out = {BASELINE: peer}
     for arm in ARMS[1:]:
@@ -88,7 +89,7 @@ def markdown(s: dict) -> str:
 
 
 def main() -> None:
-    root = Path(sys.argv[1]) if len(sys.argv) > 1 else Path("experiments/defaults/results")
+    root = Path(sys.argv[1]) if len(sys.argv) > 1 else REPO / "experiments" / "defaults" / "results"
     s = summary(arm_records(root))
     (root / "comparison.json").write_text(json.dumps(s, indent=1) + "\n")
     (root / "comparison.md").write_text(markdown(s))

@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from activeintent.registry import load_plugin
+from activeintent.results import read_results
 from activeintent.runner import build_episode
 from activeintent.spec import RunSpec
 
@@ -26,7 +27,7 @@ EPISODES = {
     "reward-variants/noplanner.py": ("reward-stop-noplanner", "color-match", None),
     "grammar-intentions/grammar_intentions.py": ("bayes-stop", None, f"{GRAMMAR}:PINK_BOWL"),
 }
-SCRIPTS = {"decide/clairvoyant_bound.py"}  # run with its own command line (a diagnostic, not a method)
+SCRIPTS = {"decide/clairvoyant_bound.py", "defaults/compare.py"}  # run with their own command line, not methods
 HELPERS = {"decide/acquisition.py", "decide/decision.py", "decide/needs.py", "decide/plans.py"}  # loaded by the above
 
 
@@ -61,3 +62,26 @@ def test_the_clairvoyant_bound_replays_a_decide_stop_record(tmp_path):
               "config": {"episode": spec.protocol.model_dump()}}
     row = bound.run_one(record)
     assert len(row["success_at"]) == 3 and row["baseline_success_at"] == summary["success_at"]
+
+
+def test_the_defaults_comparison_pairs_arms_and_applies_the_rule(tmp_path):
+    """Arms that are today's episodes again differ by 0 and may become the default; an arm that
+    loses on one signal may not."""
+    compare = load_plugin(EXPERIMENTS / "defaults" / "compare.py")
+    peer = [r for r in read_results(compare.REPO / "docs" / "results" / "peer" / "results.jsonl")
+            if r["method"] in compare.LEARNERS and r["intention"].startswith("dev-") and r["trial"] < compare.TRIALS]
+    dev = sorted({r["intention"] for r in peer})
+    for arm in compare.ARMS[1:]:
+        folder = tmp_path / f"dev-{arm}"
+        folder.mkdir()
+        (folder / "bench.json").write_text(json.dumps({"intentions": dev}))
+        worse = arm == "fitted-belief"
+        lines = [{**r, "success_at": [0.0] * len(r["success_at"])} if worse and r["method"] == "lang-stop" else r
+                 for r in peer]
+        (folder / "results.jsonl").write_text("".join(json.dumps(r) + "\n" for r in lines))
+    s = compare.summary(compare.arm_records(tmp_path))
+    by = {(p["arm"], p["method"]): p for p in s["paired"]}
+    assert by[("length-belief", "lang-stop")]["mean"] == 0 and by[("length-belief", "lang-stop")]["n"] == 100
+    assert by[("fitted-belief", "lang-stop")]["mean"] < 0
+    assert s["eligible"] == ["length-belief", "fitted-sampled"] and s["default"] == "length-belief"
+    assert "Default: length-belief" in compare.markdown(s)

@@ -382,7 +382,7 @@ def _cache_sources() -> list[Path]:
     all of world/, intentions/."""
     pkg = Path(__file__).resolve().parents[2]
     goals = [pkg / "goals" / name for name in ("facts.py", "language.py", "planning.py", "recipes.py")]
-    return [pkg / "learners" / "bayes" / "hypotheses.py", *goals, pkg / "registry.py",
+    return [pkg / "learners" / "bayes" / "hypotheses.py", *goals, pkg / "registry.py", pkg / "memo.py",
             *sorted((pkg / "world").glob("*.py")), *sorted((pkg / "intentions").glob("*.py"))]
 
 
