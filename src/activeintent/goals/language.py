@@ -37,11 +37,10 @@ from activeintent.registry import Registry
 from activeintent.world import BLOCK_SIZE, BOUNDS, PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState
 from activeintent.world.colors import COLOR_NAMES, COOL_COLORS, WARM_COLORS
 from activeintent.world.relations import table_position_name
-from activeintent.world.scene import ALL_OBJECTS, color_of, footprint_radius, kind_of
+from activeintent.world.scene import ALL_OBJECTS, MIN_SPACING, color_of, footprint_radius, kind_of
 
 Group = tuple[str, ...]
 RAINBOW = ("red", "orange", "yellow", "green", "cyan", "blue", "purple", "pink", "brown", "gray")
-MIN_SPACING = 0.03  # centres of neighbours in a row/column are at least this far apart
 
 
 def own_bowl(block: str) -> str:

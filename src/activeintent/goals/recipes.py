@@ -28,11 +28,10 @@ from activeintent.goals.language import (
 )
 from activeintent.goals.planning import area_points, area_spots, nearest_points, put_free
 from activeintent.world import PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState, apply_skill
-from activeintent.world.scene import kind_of
+from activeintent.world.scene import ROW_PITCH, kind_of
 
 Group = tuple[str, ...]
 PlanResult = tuple[WorldState, list[Skill]] | None
-ROW_PITCH = 0.052  # centre spacing of blocks set next to each other (world.predict)
 
 
 class Leaf:

@@ -9,8 +9,7 @@ from __future__ import annotations
 
 from activeintent.intentions.placement import LINE_TOL, on_table
 from activeintent.world import Relations, WorldState
-
-MIN_SPACING = 0.03  # two blocks on one surface closer than this would overlap
+from activeintent.world.scene import MIN_SPACING
 
 
 class StraightLine:

@@ -13,13 +13,13 @@ import numpy as np
 
 from activeintent.world import BOUNDS, PutAt, Relations, Skill, WorldState, apply_plan, relations
 from activeintent.world.predict import SkillFailure, apply_skill, target_position
+from activeintent.world.scene import ROW_PITCH as ROW_PITCH  # the suites read it here
 from activeintent.world.scene import color_of
 
 if TYPE_CHECKING:
     from activeintent.intentions.base import Intention
 
 # Spacing of blocks laid side by side with PutNextTo (block radius + block radius + 1.2 cm gap).
-ROW_PITCH = 0.052
 # Largest spread of the shared coordinate within a row or column (the "same y within ~2 cm").
 LINE_TOL = 0.02
 

@@ -75,7 +75,7 @@ from activeintent.world.skills import TABLE_POSITIONS
 
 CENTRE = np.array([0.0, -0.5])
 CORNERS = ("top left corner", "top right corner", "bottom left corner", "bottom right corner")
-RAINBOW = ("red", "orange", "yellow", "green", "cyan", "blue", "purple")
+SEVEN_RAINBOW_COLOURS = ("red", "orange", "yellow", "green", "cyan", "blue", "purple")
 SIDES = ("nearest", "left", "right", "front", "behind")
 
 
@@ -239,7 +239,7 @@ def _emptiest_bowls(state: WorldState, rel: Relations, block: str, bowls: Iterab
 
 def _rank(block: str) -> int | None:
     c = color_of(block)
-    return RAINBOW.index(c) if c in RAINBOW else None
+    return SEVEN_RAINBOW_COLOURS.index(c) if c in SEVEN_RAINBOW_COLOURS else None
 
 
 class RainbowRow(Intention):
@@ -278,7 +278,7 @@ class RainbowRow(Intention):
 
     def sample_scene(self, rng: np.random.Generator) -> Scene:
         n_blocks = 3 + int(rng.integers(0, 2))
-        return _scene(_pick(rng, n_blocks, RAINBOW), _pick(rng, _bowl_count(rng, n_blocks, 1)))
+        return _scene(_pick(rng, n_blocks, SEVEN_RAINBOW_COLOURS), _pick(rng, _bowl_count(rng, n_blocks, 1)))
 
     def plan(self, state: WorldState) -> list[Skill] | None:
         if not self.feasible(state.scene):
