@@ -27,11 +27,14 @@ TRIALS = 10
 
 def arm_records(root: Path) -> dict[str, list[dict]]:
     """Every arm's records, methods named ``<method>@<arm>`` so that one list pairs them."""
-    dev = set(json.loads((root / "dev-fitted-belief" / "bench.json").read_text())["intentions"])
+    ran = [arm for arm in ARMS[1:] if (root / f"dev-{arm}" / "results.jsonl").is_file()]
+    if not ran:
+        raise SystemExit(f"no arm has run yet under {root} (run.sh makes them)")
+    dev = set(json.loads((root / f"dev-{ran[0]}" / "bench.json").read_text())["intentions"])
     peer = [r for r in read_results(REPO / "docs" / "results" / "peer" / "results.jsonl")
             if r["method"] in LEARNERS and r["intention"] in dev and r["trial"] < TRIALS]
     out = {BASELINE: peer}
-    for arm in ARMS[1:]:
+    for arm in ran:
         out[arm] = list(read_results(root / f"dev-{arm}" / "results.jsonl"))
     return out
 
@@ -53,16 +56,20 @@ def summary(records: dict[str, list[dict]]) -> dict:
                          "area": sum(areas) / len(areas) if areas else None,
                          "new_scene_share": sum(new_scene) / sum(answers) if sum(answers) else None})
     paired = []
-    for arm in ARMS[1:]:
+    ran = [arm for arm in ARMS[1:] if arm in records]
+    for arm in ran:
         for method in LEARNERS:
             c = paired_comparison(pooled, f"{method}@{arm}", f"{method}@{BASELINE}")
             if c is not None:
                 paired.append({"arm": arm, "method": method, **c})
-    eligible = [arm for arm in ARMS[1:]
+    eligible = [arm for arm in ran
                 if all(p["mean"] >= 0 for p in paired if p["arm"] == arm)
                 and sum(p["arm"] == arm for p in paired) == len(LEARNERS)]
     best = max(eligible, key=lambda arm: sum(p["mean"] for p in paired if p["arm"] == arm), default=None)
-    return {"rows": rows, "paired": paired, "eligible": eligible, "default": best or BASELINE}
+    missing = [arm for arm in ARMS[1:] if arm not in records]
+    # the rule chooses among all arms: with one not run yet there is no choice to make
+    default = None if missing else (best or BASELINE)
+    return {"rows": rows, "paired": paired, "eligible": eligible, "missing": missing, "default": default}
 
 
 def markdown(s: dict) -> str:
@@ -84,7 +91,9 @@ def markdown(s: dict) -> str:
                      f"{p['final_mean']:+.3f} [{p['final_lo']:+.3f}, {p['final_hi']:+.3f}] |")
     lines += ["", "Rule: an arm may become the default only if its paired mean is ≥ 0 for both signals; among "
               "those, the highest mean of the two wins.", "",
-              f"Eligible: {', '.join(s['eligible']) or 'none'}. **Default: {s['default']}**.", ""]
+              f"Eligible: {', '.join(s['eligible']) or 'none'}. " + (
+                  f"**Default: {s['default']}**." if s["default"] else
+                  f"**No default chosen yet**: not run yet: {', '.join(s['missing'])}."), ""]
     return "\n".join(lines)
 
 

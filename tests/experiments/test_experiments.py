@@ -85,3 +85,9 @@ def test_the_defaults_comparison_pairs_arms_and_applies_the_rule(tmp_path):
     assert by[("fitted-belief", "lang-stop")]["mean"] < 0
     assert s["eligible"] == ["length-belief", "fitted-sampled"] and s["default"] == "length-belief"
     assert "Default: length-belief" in compare.markdown(s)
+
+    # an arm not run yet: the others are reported, no default is chosen
+    (tmp_path / "dev-fitted-sampled" / "results.jsonl").unlink()
+    s = compare.summary(compare.arm_records(tmp_path))
+    assert s["missing"] == ["fitted-sampled"] and s["default"] is None
+    assert "No default chosen yet" in compare.markdown(s)
