@@ -2,11 +2,11 @@
 on the same dev episodes, in area under success@k (k = 0..10), per signal; and the rule that
 picks the default. Run from the repository's root after run.sh:
 
-    .venv/bin/python experiments/defaults/compare.py [RESULTS_ROOT]
+    .venv/bin/python experiments/defaults/compare.py [RESULTS_ROOT [OUT]]
 
 RESULTS_ROOT holds dev-length-belief, dev-fitted-sampled and dev-fitted-belief (default:
 experiments/defaults/results); the baseline arm is docs/results/peer's lang-* dev episodes of
-trials 0-9. Writes RESULTS_ROOT/comparison.md and comparison.json.
+trials 0-9. Writes OUT/comparison.md and comparison.json (default: this experiment's folder).
 """
 
 from __future__ import annotations
@@ -99,9 +99,10 @@ def markdown(s: dict) -> str:
 
 def main() -> None:
     root = Path(sys.argv[1]) if len(sys.argv) > 1 else REPO / "experiments" / "defaults" / "results"
+    out = Path(sys.argv[2]) if len(sys.argv) > 2 else Path(__file__).resolve().parent
     s = summary(arm_records(root))
-    (root / "comparison.json").write_text(json.dumps(s, indent=1) + "\n")
-    (root / "comparison.md").write_text(markdown(s))
+    (out / "comparison.json").write_text(json.dumps(s, indent=1) + "\n")
+    (out / "comparison.md").write_text(markdown(s))
     print(markdown(s))
 
 
