@@ -51,6 +51,18 @@ KEY_ID_CHARS = 16  # of the key's SHA-256: enough to tell browsers apart, useles
 # Only these files are ever served from a session folder.
 SERVED_FILE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]*\.(webm|mp4|gif)$")
 
+def _record_viewing(v: dict, event: str) -> dict:
+    """Apply a video event to its viewing record (first ``ready`` / ``ended`` times, replays:
+    a replay only after the end); a copy of the record after it. Called under the events lock."""
+    if event == "replay" and v["ended"] is None:
+        raise ApiError(409, "conflict", "a replay comes after the first viewing has ended")
+    if event in ("ready", "ended") and v[event] is None:
+        v[event] = time.time()
+    if event == "replay":
+        v["replays"] += 1
+    return dict(v)
+
+
 def signal_page(signal: str) -> str:
     """The path of a signal's answer page in the web app."""
     return f"/signal/{signal}"
@@ -524,14 +536,7 @@ class WebSession:
         if q is None or q.round != round or self.status != "waiting-for-answer":
             raise ApiError(409, "conflict", f"round {round} is not on screen in session {self.id}")
         with self._events_lock:
-            v = self._viewing.setdefault(round, {"ready": None, "ended": None, "replays": 0})
-            if event == "replay" and v["ended"] is None:
-                raise ApiError(409, "conflict", "a replay comes after the first viewing has ended")
-            if event in ("ready", "ended") and v[event] is None:
-                v[event] = time.time()
-            if event == "replay":
-                v["replays"] += 1
-            out = dict(v)
+            out = _record_viewing(self._viewing.setdefault(round, {"ready": None, "ended": None, "replays": 0}), event)
         self.log_server(f"video_{event}", round=round, media_time=media_time, replays=out["replays"])
         return out
 
@@ -541,14 +546,7 @@ class WebSession:
         if not self.asks_final_attempt:
             raise ApiError(409, "conflict", f"session {self.id} is {self.status}: there is no final attempt to watch")
         with self._events_lock:
-            v = self._final_viewing
-            if event == "replay" and v["ended"] is None:
-                raise ApiError(409, "conflict", "a replay comes after the first viewing has ended")
-            if event in ("ready", "ended") and v[event] is None:
-                v[event] = time.time()
-            if event == "replay":
-                v["replays"] += 1
-            out = dict(v)
+            out = _record_viewing(self._final_viewing, event)
         self.log_server(f"final_video_{event}", media_time=media_time, replays=out["replays"])
         return out
 
