@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -22,7 +23,10 @@ pytest_plugins = ["pytester", "suite_rules"]
 # A run points all of them at a fresh temporary home, so it neither reads stale results from the
 # user's caches nor writes into them. This happens in pytest_configure rather than in a fixture
 # because collection already imports the code (and could read a cache).
-_CACHE_VARIABLES = ("HOME", "XDG_CACHE_HOME", "ACTIVEINTENT_CACHE")
+# The language's hypothesis spaces are the exception: content-addressed (the hash of their
+# sources is in the file name), minutes to build, so kept in the checkout's .pytest_cache and
+# shared by the run's workers (one builds, the others wait for it and read it).
+_CACHE_VARIABLES = ("HOME", "XDG_CACHE_HOME", "ACTIVEINTENT_CACHE", "ACTIVEINTENT_SPACE_CACHE")
 _saved_environment: dict[str, str | None] = {}
 _temporary_root: list[Path] = []
 
@@ -34,12 +38,26 @@ def pytest_configure(config: pytest.Config) -> None:
         "HOME": home,
         "XDG_CACHE_HOME": home / ".cache",
         "ACTIVEINTENT_CACHE": home / ".cache" / "activeintent",
+        "ACTIVEINTENT_SPACE_CACHE": Path(config.rootpath) / ".pytest_cache" / "activeintent-spaces",
     }
     values["ACTIVEINTENT_CACHE"].mkdir(parents=True)
+    values["ACTIVEINTENT_SPACE_CACHE"].mkdir(parents=True, exist_ok=True)
     for name, value in values.items():
         _saved_environment[name] = os.environ.get(name)
         os.environ[name] = str(value)
     _temporary_root.append(root)
+
+
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """In CI, before the workers start: the default language's two starting spaces (length and
+    fitted prior), built side by side, so that no test waits minutes for one."""
+    if not os.environ.get("CI") or hasattr(session.config, "workerinput"):
+        return
+    code = ("import sys; from activeintent.learners.lang.hypotheses import lang_space; "
+            "from activeintent.learners.lang.learner import KEEP; lang_space(0, KEEP, sys.argv[1])")
+    builds = [subprocess.Popen([sys.executable, "-c", code, prior]) for prior in ("length", "fitted")]
+    for build in builds:
+        build.wait()
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:

@@ -50,8 +50,8 @@ Scored, look_particles = decide.acquisition.Scored, decide.acquisition.look_part
 class ClairvoyantChooser(decide.DecideLearner):
     """decide-stop whose query choice reads the hidden intention (a bound, not a learner)."""
 
-    def __init__(self, intention, rng, pool: int = 0):
-        super().__init__("stop", rng=rng, config=decide.DecideConfig(**decide.DECIDE, pool=pool))
+    def __init__(self, intention, rng, pool: int = 0, language: int = 1):
+        super().__init__("stop", rng=rng, config=decide.DecideConfig(**decide.DECIDE, pool=pool, language=language))
         self.name = "clairvoyant-decide-stop"
         self.intention = intention
         self.truth = IntentionJudge(intention)
@@ -115,7 +115,9 @@ def run_one(record: dict) -> dict:
     protocol = ProtocolConfig(**record["config"]["episode"])  # the record's episode, seeds included
     seeds = protocol.seeds
     user = SimulatedUser(intention, "stop", user_profile("exact"), rng=seeds.user)
-    learner = ClairvoyantChooser(intention, seeds.learner, POOL)
+    # the record's goal language (one written before the field ran in language 1)
+    language = record.get("config", {}).get("options", {}).get("language", 1)
+    learner = ClairvoyantChooser(intention, seeds.learner, POOL, language)
     res = Episode(learner, intention, user, make_executor("plan"), SymbolicEnv(), protocol).run()
     return {"intention": record["intention"], "seed": record["seed"], "user_preset": "exact",
             "budget": protocol.budget, "pool": POOL, "success_at": res.success_at,

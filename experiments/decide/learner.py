@@ -26,7 +26,7 @@ from pydantic import Field
 
 from activeintent import ranking
 from activeintent.goals import planner
-from activeintent.goals.language import Goal, all_clauses
+from activeintent.goals.language import Goal, all_clauses, speaking
 from activeintent.learners.base import Estimate, LearnerContext, Method, RoundRecord
 from activeintent.learners.bayes.candidates import candidate_plans, predict
 from activeintent.learners.bayes.hypotheses import random_scene
@@ -52,15 +52,18 @@ needs_mod = load_plugin(_here / "needs.py")
 plans = load_plugin(_here / "plans.py")
 
 DECIDE = {"scenes": "belief", "gain": "decision", "needs": True}
-_POOLS: dict[float, LangSpace] = {}
+_POOLS: dict[tuple[float, int], LangSpace] = {}
 
 
-def one_clause_pool(cut: float) -> LangSpace:
-    """Every one-clause goal of the language, with and without "every other block stays", that
-    is longer than ``cut`` bits (built once per process; learners reset its planner verdicts)."""
-    key = round(cut, 6)
+def one_clause_pool(cut: float, language: int) -> LangSpace:
+    """Every one-clause goal of language ``language``, with and without "every other block
+    stays", that is longer than ``cut`` bits (built once per process; learners reset its planner
+    verdicts)."""
+    key = (round(cut, 6), language)
     if key not in _POOLS:
-        _POOLS[key] = LangSpace([g for c in all_clauses() for g in (Goal((c,)), Goal((c,), True)) if g.bits > cut])
+        with speaking(language):
+            goals = [g for c in all_clauses() for g in (Goal((c,)), Goal((c,), True)) if g.bits > cut]
+        _POOLS[key] = LangSpace(goals, language=language)
     return _POOLS[key]
 
 
@@ -96,14 +99,15 @@ class DecideLearner(LangLearner):
         super().__init__(signal, rng, llm, config, hypotheses, keep)
         self.config: DecideConfig = config
         if config.pool:  # every one-clause goal above the cut, scored on each answer as it comes
-            self.pool = one_clause_pool(self.cut)
+            self.pool = one_clause_pool(self.cut, self.language)
             self.pool.reset()
             self.pool_judge = LangJudge(self.pool)
-            self.pool_log_post = -np.array([g.bits for g in self.pool.goals]) * np.log(2)  # up to a constant
+            self.pool_log_post = -np.array([h.bits for h in self.pool.hypotheses]) * np.log(2)  # up to a constant
             self.growth["pool"] = 0
         self._classes = None
         self._look_pool: list[np.ndarray] = []  # this round's query tables (lookahead; cleared at each answer)
-        self.needs = needs_mod.Needs(config.new_scene_error, config.needs_counts) if config.needs else None
+        self.needs = (needs_mod.Needs(config.new_scene_error, config.needs_counts, self.language)
+                      if config.needs else None)
         self.deploy = (decision.deployment_states(int(self.rng.integers(2**31)), config.deploy_scenes)
                        if self._deciding() else [])
 
@@ -313,7 +317,7 @@ def decide_method(signal: str, name: str | None = None, keep: int = KEEP, descri
     name = name or f"decide-{signal}"
 
     def build(ctx: LearnerContext) -> DecideLearner:
-        config = DecideConfig(prior=ctx.config.prior, **{**DECIDE, **settings})
+        config = DecideConfig(prior=ctx.config.prior, language=ctx.config.language, **{**DECIDE, **settings})
         learner = DecideLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=config, keep=keep)
         learner.name = name
         return learner

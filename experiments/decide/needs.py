@@ -29,7 +29,7 @@ import math
 
 import numpy as np
 
-from activeintent.goals.language import NODES
+from activeintent.goals.language import NODES, nodes
 from activeintent.learners.bayes.hypotheses import random_scene
 from activeintent.world import COLOR_NAMES, WARM_COLORS, Scene
 from activeintent.world.scene import color_of, kind_of
@@ -80,15 +80,15 @@ _COUNT_BANK = 400  # seeded scenes on which a count literal must vary and differ
 
 
 @functools.cache
-def count_literals() -> tuple[tuple[str, object], ...]:
-    """"At least n blocks picked by selector (s, p)" for n = 1, 2 and every selector of the
-    language, each kept only if on a seeded bank of random scenes it is sometimes true, sometimes
+def count_literals(language: int = 1) -> tuple[tuple[str, object], ...]:
+    """"At least n blocks picked by selector (s, p)" for n = 1, 2 and every selector of the goal
+    language ``language`` (its version), each kept only if on a seeded bank of random scenes it is sometimes true, sometimes
     false, and unlike every literal kept before it, base literals included (made on first use)."""
     rng = np.random.default_rng(0)
     scenes = [tuple(random_scene(rng).objects) for _ in range(_COUNT_BANK)]
     seen = {row.tobytes() for row in np.array([_truth(LITERALS, s) for s in scenes]).T}
     out: list[tuple[str, object]] = []
-    for sel, node in NODES["selector"].items():
+    for sel, node in nodes("selector", language).items():
         for p in node.params:
             for n in (1, 2):
                 lit = ("picks>=", (sel, p, n))
@@ -106,10 +106,10 @@ LITERALS = _base_literals()
 class Needs:
     """The belief v over requirements R (index sets of literals; the empty set: no requirement)."""
 
-    def __init__(self, new_scene_error: float, counts: bool = False):
+    def __init__(self, new_scene_error: float, counts: bool = False, language: int = 1):
         self.error = new_scene_error
         self.counts = counts
-        self.literals = LITERALS + list(count_literals()) if counts else LITERALS
+        self.literals = LITERALS + list(count_literals(language)) if counts else LITERALS
         n = len(self.literals)
         sets = [()] + [c for k in range(1, MAX_LITERALS + 1) for c in itertools.combinations(range(n), k)]
         self.size = len(sets)

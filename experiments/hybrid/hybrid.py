@@ -149,7 +149,7 @@ class HybridLearner(Learner):
 
 def hybrid_method(signal: str, decision: str = "mixture") -> Method:
     def build(ctx: LearnerContext) -> HybridLearner:
-        return HybridLearner(signal, ctx.learner_seed, lang=LangConfig(prior=ctx.config.prior), llm=ctx.llm,
+        return HybridLearner(signal, ctx.learner_seed, lang=LangConfig(prior=ctx.config.prior, language=ctx.config.language), llm=ctx.llm,
                              decision=decision)
 
     return Method(signal, False, build, f"ours: lang-{signal}'s belief and queries with a reward-feature "

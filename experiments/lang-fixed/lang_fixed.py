@@ -12,7 +12,8 @@ from activeintent.learners.registry import METHODS, LearnerContext, Method
 
 def _fixed(signal: str) -> Method:
     def build(ctx: LearnerContext) -> LangLearner:
-        learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=LangConfig(prior=ctx.config.prior, rejuvenate_top=0))
+        learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=LangConfig(prior=ctx.config.prior, rejuvenate_top=0,
+                                                                                    language=ctx.config.language))
         learner.name = f"lang-fixed-{signal}"
         return learner
 

@@ -116,7 +116,8 @@ def add_naturalness(belief: Belief, n_bits: np.ndarray, weight: float | None) ->
 
 
 def natural_learner(signal: str, weight: float | None, ctx: LearnerContext, name: str) -> LangLearner:
-    learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=LangConfig(prior=ctx.config.prior))
+    learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=LangConfig(prior=ctx.config.prior,
+                                                                                           language=ctx.config.language))
     learner.name = name
     start = [g for sp in learner.base for g in sp.goals]  # the learner's own starting space, in order
     add_naturalness(learner.belief, sentence_bits([g.sentence() for g in start]), weight)

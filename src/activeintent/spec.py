@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
+from activeintent.goals.language import LATEST, check_language
 from activeintent.protocol import (
     DEFAULT_BUDGET,
     DEFAULT_TEST_POOL,
@@ -101,6 +102,8 @@ class LearnerConfig(BaseModel):
                        description="length | uniform | fitted (lang-* only) | file:PATH (lang-*, from `prior fit`)")
     scenes: str = Field("sampled", pattern="^(sampled|belief)$",
                         description="bayes-* and lang-*: sampled scenes, or scenes the belief expects to show z")
+    language: int = Field(LATEST, description="lang-*: the goal language's version (recorded, so that an episode "
+                          "run before the language grew replays in its own)")
     epsilon: float = Field(2.0, ge=0, description="ε: seconds before the stop for image I_b")
     early_threshold: float | None = Field(2.0, ge=0, description="eq. 3: a stop earlier than this shows no I_b (None: ε)")
     variant: str = Field("faithful", description="the paper's methods: faithful (as the paper ran them) | structured")
@@ -114,6 +117,11 @@ class LearnerConfig(BaseModel):
         if v not in VARIANTS:
             raise ValueError(f"Unknown variant {v!r}; valid variants: {', '.join(VARIANTS)}.")
         return v
+
+    @field_validator("language")
+    @classmethod
+    def _known_language(cls, v: int) -> int:
+        return check_language(v)
 
 
 class EnvConfig(BaseModel):
@@ -201,6 +209,7 @@ OPTIONS: dict[str, tuple[str | None, str]] = {
     "new_scene": ("protocol", "new_scene"),
     "prior": ("learner", "prior"),
     "scenes": ("learner", "scenes"),
+    "language": ("learner", "language"),
     "llm": ("models", "llm"),
     "vlm": ("models", "vlm"),
     "base_url": ("models", "base_url"),
@@ -216,3 +225,7 @@ OPTIONS: dict[str, tuple[str | None, str]] = {
     "curve": ("protocol", "curve"),
     "stop_when_done": ("protocol", "stop_when_done"),
 }
+
+# Options added after results were recorded, with the value those results ran with: a record or a
+# bench.json without the option gets it (bench.work.bench_json, bench.verify.migrated).
+OPTIONS_ADDED = {"scenes": "sampled", "language": 1}

@@ -15,7 +15,7 @@ import pytest
 
 from activeintent.bench import truth_goals as tg
 from activeintent.bench.report import MIN_SCORED
-from activeintent.goals.language import NODES, QUANTS, Each, parse_goal
+from activeintent.goals.language import NODES, QUANTS, Each, nodes, parse_goal
 from activeintent.learners.lang.hypotheses import GoalIntention
 from activeintent.suites import SUITE_NAMES, resolve, suite, suite_of
 
@@ -58,9 +58,9 @@ def test_the_draw_is_uniform_over_the_structure_not_the_prior():
     uniform([g.stays for g in goals], (False, True), 0.1)
     uniform([isinstance(c, Each) for c in clauses], (False, True), 0.1)
     uniform([c.quant for c in each], QUANTS)
-    uniform([c.sel for c in clauses], NODES["selector"])  # node types uniform, not by their sizes
-    uniform([c.rel for c in each], NODES["relation"])
-    uniform([c.struct for c in clauses if not isinstance(c, Each)], NODES["structure"])
+    uniform([c.sel for c in clauses], nodes("selector", tg.LANGUAGE))  # node types uniform, not by their sizes
+    uniform([c.rel for c in each], nodes("relation", tg.LANGUAGE))
+    uniform([c.struct for c in clauses if not isinstance(c, Each)], nodes("structure", tg.LANGUAGE))
     uniform([c.sp for c in clauses if c.sel == "class"], NODES["selector"]["class"].params)
     assert all(list(g.clauses) == sorted(g.clauses, key=lambda c: c.key) for g in goals)
 

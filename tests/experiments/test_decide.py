@@ -29,7 +29,12 @@ Scored, select_query, stack_tables, two_step = (acquisition.Scored, acquisition.
 DecisionTable, class_information, decision_classes, decision_value, deployment_states = (
     decision.DecisionTable, decision.class_information, decision.decision_classes, decision.decision_value,
     decision.deployment_states)
-DECIDE, LangConfig, LangLearner = decide.DECIDE, decide.DecideConfig, decide.DecideLearner
+DECIDE, LangLearner = decide.DECIDE, decide.DecideLearner
+
+
+def LangConfig(**settings):  # noqa: N802 - stands for the config class
+    """decide's settings in language 1 of the goal language, where its findings were measured."""
+    return decide.DecideConfig(**{"language": 1, **settings})
 
 RED_ON_BLUE = "every colour:red on-the-block:blue"
 OTHERS = ["form tower:any all:", "every all: in-bowl:any", "form row:any all:", "every colour:green on-table:"]

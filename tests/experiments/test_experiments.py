@@ -43,7 +43,8 @@ def test_the_experiment_runs_one_episode(plugin, tmp_path):
     method, intention, intention_file = EPISODES[plugin]
     spec = RunSpec.from_options(method=method, intention=intention, intention_file=intention_file,
                                 plugins=[str(EXPERIMENTS / plugin)], env="symbolic", llm="none", budget=2,
-                                test_scenes=3, test_pool=0, video="none", seed=1)
+                                test_scenes=3, test_pool=0, video="none", seed=1,
+                                language=1)  # the language the findings were measured in
     result = build_episode(spec, tmp_path).run()
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["method"] == method and summary["signals_used"] == 2
@@ -59,7 +60,7 @@ def test_the_clairvoyant_bound_replays_a_decide_stop_record(tmp_path):
     build_episode(spec, tmp_path).run()
     summary = json.loads((tmp_path / "summary.json").read_text())
     record = {"intention": "color-match", "seed": 2, "method": "decide-stop", "success_at": summary["success_at"],
-              "config": {"episode": spec.protocol.model_dump()}}
+              "config": {"episode": spec.protocol.model_dump(), "options": spec.options()}}
     row = bound.run_one(record)
     assert len(row["success_at"]) == 3 and row["baseline_success_at"] == summary["success_at"]
 

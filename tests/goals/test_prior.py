@@ -54,15 +54,30 @@ def test_smoothing_keeps_every_goal_possible_and_its_strength_is_chosen_by_cross
     assert choose_alpha(goals) in (0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0)
 
 
-def test_the_packaged_prior_is_fitted_to_the_committed_corpus():
+@pytest.mark.parametrize("language,corpus", [(1, "translations.jsonl"), (2, "translations-2.jsonl")])
+def test_the_packaged_prior_of_each_language_is_fitted_to_its_committed_corpus(language, corpus):
     from pathlib import Path
 
-    corpus = Path(__file__).resolve().parents[2] / "data" / "requests" / "translations.jsonl"
-    goals, digest = read_corpus(corpus)
-    packaged = load_prior("fitted")
-    assert packaged.corpus == digest and packaged.requests == len(goals)
-    refit = fit(goals, packaged.alpha, digest)
+    from activeintent.goals.language import speaking
+
+    with speaking(language):
+        goals, digest = read_corpus(Path(__file__).resolve().parents[2] / "data" / "requests" / corpus)
+        packaged = load_prior("fitted")
+        assert packaged.language == language
+        assert packaged.corpus == digest and packaged.requests == len(goals)
+        refit = fit(goals, packaged.alpha, digest)
     assert refit.to_json() == packaged.to_json()
+
+
+def test_a_prior_fitted_over_one_language_is_refused_for_a_run_in_another(tmp_path):
+    from activeintent.goals.language import speaking
+
+    with speaking(1):
+        path = tmp_path / "prior-1.json"
+        path.write_text(json.dumps(fit(corpus_goals(), 0.3).to_json()))
+        assert load_prior(f"file:{path}").language == 1
+    with pytest.raises(PriorError, match="fitted over language 1, the run speaks language 2"):
+        load_prior(f"file:{path}", 2)
 
 
 def test_a_learner_under_the_fitted_prior_reads_its_weights(tmp_path):

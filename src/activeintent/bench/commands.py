@@ -136,10 +136,12 @@ def bench(
     ceiling = None
     if oracle:
         from activeintent.bench.coverage import oracle_of
+        from activeintent.goals.language import speaking
         from activeintent.progress_lines import print_line
 
-        ceiling = oracle_of({i: resolve(None, i) if ".py:" in i else resolve(i) for i in all_intentions},
-                            progress=lambda text: print_line(console, text))
+        with speaking(run.learner.language):  # the ceiling of the language the learners spoke
+            ceiling = oracle_of({i: resolve(None, i) if ".py:" in i else resolve(i) for i in all_intentions},
+                                progress=lambda text: print_line(console, text))
     report = write_report(records, method_list, all_intentions, out, settings, labels=labels, oracle=ceiling)
     plot_success_vs_signals(records, method_list, budget, out, labels=labels, settings=settings)
     console.print(report.read_text(), markup=False, soft_wrap=True)

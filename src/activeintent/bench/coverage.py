@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from activeintent.goals.facts import facts
-from activeintent.goals.language import Goal, all_clauses, parse_goal
+from activeintent.goals.language import Goal, all_clauses, parse_goal, spoken
 from activeintent.goals.planner import generic_moves, plan
 from activeintent.intentions.base import Intention
 from activeintent.learners.lang.space import Compiled
@@ -294,7 +294,7 @@ def coverage_table(intentions: list[Intention], suites: list[str], seed: int = 0
                     "expressible": int((rates >= EXPRESSIBLE).sum()),
                     "median_bits": round(float(np.median([r["bits"] for r in got])), 2),
                     "in_start_space": int(sum(r["in_start_space"] for r in got))})
-    return {"protocol": {"seed": seed, "selection_scenes": scenes, "test_scenes": test_scenes,
+    return {"protocol": {"language": spoken(), "seed": seed, "selection_scenes": scenes, "test_scenes": test_scenes,
                          "scenes": "the protocol's test-scene distribution, kept when the intention is feasible",
                          "plan": "the language's planner, variant 0, executed on the symbolic world model",
                          "search": "one- and two-clause goals, with and without 'stays'",
@@ -319,8 +319,9 @@ def explain_intention(intention, seed: int = 0) -> dict:
 
 
 def cached_coverage(intention: Intention, seed: int = 0) -> dict:
-    """``coverage(intention).row()``, kept on disk per language (the cache key of the learner's
-    space: the language's sources and node types), intention (its class's source) and seed."""
+    """``coverage(intention).row()`` in the language in force, kept on disk per language (its
+    version, and the cache key of the learner's space: the language's sources and node types),
+    intention (its class's source) and seed."""
     import hashlib
     import inspect
     from pathlib import Path
@@ -333,7 +334,7 @@ def cached_coverage(intention: Intention, seed: int = 0) -> dict:
         source = repr(type(intention))
     tag = hashlib.sha256("\0".join([Path(__file__).read_text(), intention.name, intention.description, source,
                                     getattr(getattr(intention, "goal", None), "key", "")]).encode()).hexdigest()[:16]
-    return cached_json(cache_path(f"coverage-{seed}-{tag}"),
+    return cached_json(cache_path(f"coverage-{seed}-{tag}-v{spoken()}"),
                        lambda: coverage(intention, seed=seed, start_keys=start_space_keys()).row())
 
 

@@ -60,13 +60,14 @@ import numpy as np
 from activeintent.goals.facts import facts
 from activeintent.goals.language import (
     MAX_CLAUSES,
-    NODES,
     QUANTS,
     Each,
     Form,
     Goal,
     all_clauses,
+    nodes,
     parse_goal,
+    speaking,
 )
 from activeintent.learners.lang.hypotheses import GoalIntention
 from activeintent.protocol import (
@@ -92,11 +93,16 @@ NAME_PREFIX = "truth-"
 REDRAW = "python -m activeintent.bench.truth_goals --redraw"
 
 
+LANGUAGE = 1  # the goal language's version the suite is drawn from (goals/language.py LANGUAGES)
+
+
 def language_version() -> str:
-    """A hash of the language's definition: every clause key, MAX_CLAUSES and QUANTS (changes
-    when a node type, a parameter, a quantifier or the clause limit changes)."""
-    text = json.dumps({"clauses": sorted(c.key for c in all_clauses()), "max_clauses": MAX_CLAUSES,
-                       "quants": list(QUANTS)})
+    """A hash of the definition of language :data:`LANGUAGE`: every clause key, MAX_CLAUSES and
+    QUANTS (changes when a node type, a parameter, a quantifier or the clause limit of that
+    version changes)."""
+    with speaking(LANGUAGE):
+        text = json.dumps({"clauses": sorted(c.key for c in all_clauses()), "max_clauses": MAX_CLAUSES,
+                           "quants": list(QUANTS)})
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -117,8 +123,8 @@ def _pick(rng: np.random.Generator, options) -> str:
 
 
 def _node(rng: np.random.Generator, kind: str) -> tuple[str, str]:
-    key = _pick(rng, NODES[kind])
-    return key, _pick(rng, NODES[kind][key].params)
+    key = _pick(rng, nodes(kind, LANGUAGE))
+    return key, _pick(rng, nodes(kind, LANGUAGE)[key].params)
 
 
 def random_clause(rng: np.random.Generator) -> Each | Form:
@@ -200,6 +206,11 @@ def measure(goal: Goal, stop_below: float | None = None) -> tuple[float, float]:
     return len(feasible) / len(sample), (already / len(feasible) if feasible else 0.0)
 
 
+def _clause_count() -> int:
+    with speaking(LANGUAGE):
+        return len(all_clauses())
+
+
 def draw(seed: int = SEED, count: int = COUNT) -> dict:
     """The suite drawn from ``seed``: the contents of ``truth_goals.json``."""
     rng = np.random.default_rng(seed)
@@ -238,7 +249,7 @@ def draw(seed: int = SEED, count: int = COUNT) -> dict:
         "about": "The truth-goal suite (--suite truth-goals), drawn by activeintent.bench.truth_goals; "
                  f"do not edit by hand: redraw with `{REDRAW}`.",
         "language_version": language_version(),
-        "language": {"clauses": len(all_clauses()), "max_clauses": MAX_CLAUSES, "quants": list(QUANTS)},
+        "language": {"clauses": _clause_count(), "max_clauses": MAX_CLAUSES, "quants": list(QUANTS)},
         **settings(seed),
         "draw": {"candidates": candidates, "kept": len(kept),
                  "stays_cleared": cleared, "rejected": dict(sorted(why.items()))},

@@ -19,6 +19,7 @@ from typing import Annotated
 import typer
 
 from activeintent.protocol import FORMAT_VERSION
+from activeintent.spec import OPTIONS_ADDED
 
 NOT_VERIFIED = "NOT-VERIFIED.md"  # a folder's own word on why it cannot be re-run
 # Tokens describe what answering cost this run: a re-run whose answers come from the response
@@ -32,7 +33,6 @@ ADDED_IN_FORMAT_3 = frozenset({"diagnostics", "final_scene"})
 # (the first scene that can show the intention) was recorded.
 REDEFINED_IN_FORMAT_3 = {"final_z": "final_scene", "final_goal": "final_scene"}
 # Options added within format 3, with the value that records written before them ran with.
-OPTIONS_ADDED = {"scenes": "sampled"}
 
 
 def migrated(record: dict) -> dict:

@@ -10,7 +10,7 @@ from pathlib import Path
 from pydantic import BaseModel, Field
 
 from activeintent.protocol import trial_seeds
-from activeintent.spec import RunSpec
+from activeintent.spec import OPTIONS, OPTIONS_ADDED, RunSpec
 
 
 class WorkItem(BaseModel):
@@ -74,7 +74,13 @@ def bench_json(path: Path) -> dict:
     if version < 3 and isinstance(run, dict):
         if version == 1:
             run = {**legacy_run(run), **run}
+        run = {**OPTIONS_ADDED, **run}
         data["run"] = RunSpec.from_options(**run).model_dump(mode="json")
+    elif isinstance(run, dict):
+        for name, value in OPTIONS_ADDED.items():
+            section, field = OPTIONS[name]
+            if isinstance(run.get(section), dict):
+                run[section].setdefault(field, value)
     return data
 
 

@@ -15,6 +15,11 @@ parameter choices; the description length of an expression is the sum over its n
 log2(number of choices at that node) — a uniform choice everywhere, nothing else — and the
 prior of the learner is 2^-bits.
 
+The language is versioned (:data:`LANGUAGES`): a node type carries the version that added it
+(``since``), and what is enumerated or charged bits is the version in force (:func:`speaking`,
+default :data:`LATEST`). A recorded episode names its version, so one run before the language
+grew replays as it ran.
+
 Selectors depend only on the scene (colours of the blocks and of the bowls present), never on
 positions, so the group of a clause is fixed for a scene. A relation that names a block
 ("next to the red block") leaves that block out of the group.
@@ -27,7 +32,9 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from itertools import combinations, permutations
 
@@ -66,10 +73,16 @@ class Node:
     kind: str = ""
     key: str = ""
     params: tuple[str, ...] = ("",)
+    since: int = 1  # the language version that added this node type
 
     def bits(self, p: str | None = None) -> float:
-        """log2 of the choices below the kind: which type of node, then which parameter."""
-        return math.log2(len(NODES[self.kind])) + self.param_bits(p)
+        """log2 of the choices below the kind: which type of node, then which parameter (in the
+        language in force; memoised: every enumeration asks it for every clause)."""
+        key = (self.kind, self.key, p, spoken())
+        got = _NODE_BITS.get(key)
+        if got is None:
+            got = _NODE_BITS[key] = math.log2(len(nodes(self.kind))) + self.param_bits(p)
+        return got
 
     def param_bits(self, p: str | None) -> float:
         """Bits of parameter ``p``: a uniform choice unless the node's parameters are a grammar."""
@@ -92,6 +105,9 @@ class Relation(Node):
     """A property of one block in a state."""
 
     kind = "relation"
+    # True: with the object it names off the table, a clause of it holds whatever its quantifier
+    # (a request's "if there is one"); False: it holds for no block then.
+    vacuous_without_ref = False
 
     def phrase(self, p: str) -> str:  # after "is", e.g. "in a bowl of its own colour"
         raise NotImplementedError
@@ -151,14 +167,60 @@ class Structure(Node):
 # The node types by kind, each kind a registry (plug-ins add theirs with :func:`register`).
 NODES: dict[str, Registry[Node]] = {kind: Registry(kind) for kind in ("selector", "relation", "structure")}
 
+# The language's versions: what each added (data/requests/README.md tells how it grew).
+LANGUAGES = {
+    1: "the language of the corpus's first translation pass (commit 08fb5f6)",
+    2: "grown by the corpus rule: constructs that at least 3 untranslatable requests need",
+}
+LATEST = max(LANGUAGES)
+_SPOKEN: ContextVar[int] = ContextVar("language", default=LATEST)
+
+
+def check_language(version: int) -> int:
+    if version not in LANGUAGES:
+        raise ValueError(f"unknown language version {version!r}; valid: {', '.join(map(str, LANGUAGES))}")
+    return version
+
+
+def spoken() -> int:
+    """The language version in force (:func:`speaking`)."""
+    return _SPOKEN.get()
+
+
+@contextmanager
+def speaking(version: int) -> Iterator[int]:
+    """Enumerate and charge bits in language ``version`` inside the block."""
+    token = _SPOKEN.set(check_language(version))
+    try:
+        yield version
+    finally:
+        _SPOKEN.reset(token)
+
+
+_IN_FORCE: dict[tuple[str, int], dict[str, Node]] = {}
+_NODE_BITS: dict[tuple, float] = {}
+
+
+def nodes(kind: str, version: int | None = None) -> dict[str, Node]:
+    """The node types of ``kind`` in language ``version`` (default: the one in force), in
+    registration order."""
+    v = spoken() if version is None else version
+    got = _IN_FORCE.get((kind, v))
+    if got is None:
+        got = _IN_FORCE[(kind, v)] = {k: n for k, n in NODES[kind].items() if n.since <= v}
+    return got
+
 
 def register(node: Node) -> Node:
-    """Add a node type to the language (selector, relation or structure)."""
+    """Add a node type to the language (selector, relation or structure); a plug-in's node
+    joins every version (set ``since`` to keep it out of the older ones)."""
     if node.kind not in NODES:
         raise ValueError(f"unknown node kind {node.kind!r}; valid: {', '.join(NODES)}")
     if not node.key or " " in node.key or "|" in node.key:
         raise ValueError(f"a node key is one word without '|', got {node.key!r}")
     NODES[node.kind].register(node.key, node)
+    _IN_FORCE.clear()
+    _NODE_BITS.clear()
     return node
 
 
@@ -563,9 +625,14 @@ ORDER_WORDS = {"rainbow": "in rainbow order", "warm-first": "the warm-coloured o
 RED_TO_PURPLE = "red-to-purple"
 
 
+ORDER_KEYS: dict = {}  # orders of later node types (requested.py), by name: their sort keys
+
+
 def _order_key(order: str):
     """Sort key of an order: the rainbow rank, or the colour class (then the rainbow rank, so
     that a plan has one target; any arrangement with the classes in order satisfies it)."""
+    if order in ORDER_KEYS:
+        return ORDER_KEYS[order]
     if order in ("rainbow", RED_TO_PURPLE):
         return _rank
     first = "warm" if order == "warm-first" else "cool"
@@ -1618,6 +1685,13 @@ class Each:
         verb = "is" if n == "one" else "are"
         return f"{'exactly' if self.quant.startswith('exactly') else 'at least'} {n} {many} {verb} {rel}"
 
+    def vacuous(self, objects) -> bool:
+        """Does the clause hold because the object its conditional relation names is absent?"""
+        if not self.relation.vacuous_without_ref:
+            return False
+        r = self.relation.refers(self.rp)
+        return r is not None and r not in objects
+
     def count(self, f: Facts) -> tuple[int, int]:
         """(blocks of the group satisfying the relation, group size); a relation naming an
         object that is not on the table holds for no block."""
@@ -1628,19 +1702,21 @@ class Each:
         return sum(self.relation.ok(f, b, self.rp) for b in g), len(g)
 
     def holds(self, f: Facts) -> bool:
-        return bool(quant_holds(self.quant, *self.count(f)))
+        return self.judge(f)[0]
 
     def score(self, f: Facts) -> float:
-        return quant_score(self.quant, *self.count(f))
+        return self.judge(f)[1]
 
     def judge(self, f: Facts) -> tuple[bool, float]:
         """(holds, score) from one count (the planner's hot path)."""
+        if self.vacuous(f.pos):
+            return True, 1.0
         cnt, size = self.count(f)
         return bool(quant_holds(self.quant, cnt, size)), quant_score(self.quant, cnt, size)
 
     def moved_off(self, fb: Facts, fa: Facts, b: str) -> bool:
         g = self.group_f(fa)
-        if b not in g:
+        if b not in g or self.vacuous(fa.pos):
             return False
         ref = self.relation.refers(self.rp)
         ok = (ref is None or ref in fa.pos) and self.relation.ok(fa, b, self.rp)
@@ -1656,21 +1732,32 @@ class Each:
         """Static check in a scene of ``objects``; ``memo``: one dict per scene shared by many
         clauses (groups and per-block relation checks are computed once)."""
         memo = {} if memo is None else memo
-        r = self.relation.refers(self.rp)
-        if r is not None and r not in objects:
+        got = _memo(memo, ("each", self.sel, self.sp, self.rel, self.rp), lambda: self._can(objects, memo))
+        if got is None:  # the relation's object is absent
+            return self.relation.vacuous_without_ref
+        size, can = got
+        if not size:
             return False
-        g = _memo(memo, ("group", self.sel, self.sp, r), lambda: self.group(*_split(objects)))
-        if not g:
-            return False
-        can = sum(_memo(memo, ("rel", self.rel, self.rp, b), lambda b=b: self.relation.possible(b, objects, self.rp))
-                  for b in g)
         if self.quant == "every":
-            return can == len(g)
+            return can == size
         if self.quant == "none":
             return True
         return can >= int(self.quant[-1])
 
+    def _can(self, objects: tuple[str, ...], memo: dict) -> tuple[int, int] | None:
+        """(group size, blocks of it that can satisfy the relation), None when the relation's
+        object is absent; the same for every quantifier."""
+        r = self.relation.refers(self.rp)
+        if r is not None and r not in objects:
+            return None
+        g = _memo(memo, ("group", self.sel, self.sp, r), lambda: self.group(*_split(objects)))
+        can = sum(_memo(memo, ("rel", self.rel, self.rp, b), lambda b=b: self.relation.possible(b, objects, self.rp))
+                  for b in g)
+        return len(g), can
+
     def suggest(self, state: WorldState, f: Facts) -> list[Skill]:
+        if self.vacuous(f.pos):
+            return []
         g = self.group_f(f)
         out: list[Skill] = []
         if self.quant == "none" or (self.quant.startswith("exactly") and self.count(f)[0] > int(self.quant[-1])):
@@ -1770,7 +1857,7 @@ class Goal:
 
     clauses: tuple[Clause, ...]
     stays: bool = False
-    _bits: float = field(default=-1.0, compare=False, repr=False)
+    _bits: dict = field(default_factory=dict, compare=False, repr=False)  # per language version
 
     @property
     def key(self) -> str:
@@ -1783,8 +1870,10 @@ class Goal:
         to the clause before — the same blocks, or the others (the complement) — for log2(3)
         bits instead of log2(3) + its selector's bits. The clauses' order says nothing, so
         P(z) sums over the orders in which z can be written (n! derivations)."""
-        if self._bits >= 0:
-            return self._bits
+        version = spoken()
+        got = self._bits.get(version)
+        if got is not None:
+            return got
         n = len(self.clauses)
         if n == 1:
             bits = 2 + self.clauses[0].bits
@@ -1798,7 +1887,7 @@ class Goal:
                         b += c.selector_bits
                 total += 2.0 ** -b
             bits = n + 1 - math.log2(total)
-        object.__setattr__(self, "_bits", bits)
+        self._bits[version] = bits
         return bits
 
     def sentence(self) -> str:
@@ -1845,6 +1934,8 @@ def complement(sel: str, sp: str) -> tuple[str, str] | None:
         return "class", "cool" if sp == "warm" else "warm"
     if sel == "matching":
         return "matching", "no" if sp == "yes" else "yes"
+    if sel in ("colours", "all-but-colours"):
+        return "all-but-colours" if sel == "colours" else "colours", sp
     return None
 
 
@@ -1875,15 +1966,19 @@ def parse_goal(key: str) -> Goal:
 
 
 def all_clauses() -> list[Clause]:
-    """Every clause of the language (each node type with each of its parameters)."""
+    """Every clause of the language in force (each node type with each of its parameters)."""
     out: list[Clause] = []
-    for sel, snode in NODES["selector"].items():
+    for sel, snode in nodes("selector").items():
         for sp in snode.params:
-            for rel, rnode in NODES["relation"].items():
+            for rel, rnode in nodes("relation").items():
                 for rp in rnode.params:
                     for q in QUANTS:
                         out.append(Each(q, sel, sp, rel, rp))
-            for st, stnode in NODES["structure"].items():
+            for st, stnode in nodes("structure").items():
                 for stp in stnode.params:
                     out.append(Form(st, stp, sel, sp))
     return out
+
+
+# Language 2's node types register last: their module builds on this one.
+from activeintent.goals import requested as _requested  # noqa: E402,F401

@@ -31,18 +31,30 @@ from pathlib import Path
 
 import numpy as np
 
-from activeintent.goals.language import MAX_CLAUSES, NODES, QUANTS, Each, Form, Goal, parse_goal
+from activeintent.goals.language import (
+    MAX_CLAUSES,
+    QUANTS,
+    Each,
+    Form,
+    Goal,
+    check_language,
+    nodes,
+    parse_goal,
+    spoken,
+)
 
 ALPHAS = (0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0)  # the smoothing strengths tried
-PACKAGED = "requests.json"  # the prior fitted to data/requests, shipped as package data
+# The priors fitted to data/requests, shipped as package data: one per language version.
+PACKAGED = {1: "requests.json", 2: "requests-2.json"}
 
 
 class PriorError(ValueError):
     """A prior file or a corpus that cannot be read; the message names the file and line."""
 
 
-def choice_points() -> dict[str, tuple[str, ...]]:
-    """Every choice point of the grammar and its choices (plug-in nodes included)."""
+def choice_points(version: int | None = None) -> dict[str, tuple[str, ...]]:
+    """Every choice point of the grammar of language ``version`` (default: the one in force)
+    and its choices (plug-in nodes included)."""
     points: dict[str, tuple[str, ...]] = {
         "clauses": tuple(str(n) for n in range(1, MAX_CLAUSES + 1)),
         "stays": ("no", "yes"),
@@ -50,8 +62,8 @@ def choice_points() -> dict[str, tuple[str, ...]]:
         "quantifier": QUANTS,
     }
     for kind in ("selector", "relation", "structure"):
-        points[kind] = tuple(NODES[kind])
-        for key, node in NODES[kind].items():
+        points[kind] = tuple(nodes(kind, version))
+        for key, node in nodes(kind, version).items():
             points[f"{kind}:{key}"] = tuple(node.params)
     return points
 
@@ -77,13 +89,14 @@ class FittedPrior:
     alpha: float
     corpus: str = ""  # sha256 of the translations it was fitted to
     requests: int = 0
+    language: int = 1  # the language version whose choice points it is over
     _p: dict[str, dict[str, float]] = field(default_factory=dict, repr=False)
     _norm: tuple[float, float, float] | None = field(default=None, repr=False)
 
     def p(self, point: str) -> dict[str, float]:
         got = self._p.get(point)
         if got is None:
-            choices = choice_points()[point]
+            choices = choice_points(self.language)[point]
             seen = self.counts.get(point, {})
             total = sum(seen.get(x, 0) for x in choices) + self.alpha * len(choices)
             got = self._p[point] = {x: (seen.get(x, 0) + self.alpha) / total for x in choices}
@@ -133,8 +146,11 @@ class FittedPrior:
         return hashlib.sha256(json.dumps(self.to_json(), sort_keys=True).encode()).hexdigest()[:12]
 
     def to_json(self) -> dict:
-        return {"kind": "fitted", "alpha": self.alpha, "corpus": self.corpus, "requests": self.requests,
-                "counts": {k: dict(sorted(v.items())) for k, v in sorted(self.counts.items())}}
+        out = {"kind": "fitted", "alpha": self.alpha, "corpus": self.corpus, "requests": self.requests,
+               "counts": {k: dict(sorted(v.items())) for k, v in sorted(self.counts.items())}}
+        if self.language != 1:  # files of language 1 predate the field (their tags stay)
+            out["language"] = self.language
+        return out
 
     @classmethod
     def from_json(cls, data: dict, where: str = "prior") -> FittedPrior:
@@ -142,7 +158,8 @@ class FittedPrior:
             if data.get("kind") != "fitted":
                 raise PriorError(f"{where}: not a fitted prior (kind {data.get('kind')!r})")
             return cls({k: {x: int(c) for x, c in v.items()} for k, v in data["counts"].items()},
-                       float(data["alpha"]), data.get("corpus", ""), int(data.get("requests", 0)))
+                       float(data["alpha"]), data.get("corpus", ""), int(data.get("requests", 0)),
+                       check_language(int(data.get("language", 1))))
         except (KeyError, TypeError, ValueError, AttributeError) as err:
             if isinstance(err, PriorError):
                 raise
@@ -163,9 +180,10 @@ def count(goals: Iterable[Goal]) -> dict[str, dict[str, int]]:
 
 
 def fit(goals: list[Goal], alpha: float, corpus: str = "") -> FittedPrior:
+    """The prior of ``goals`` over the language in force."""
     if not alpha > 0:
         raise ValueError(f"the smoothing strength must be > 0 (got {alpha}): a goal nobody asked for stays possible")
-    return FittedPrior(count(goals), alpha, corpus, len(goals))
+    return FittedPrior(count(goals), alpha, corpus, len(goals), spoken())
 
 
 def folds(n: int, k: int, seed: int = 0) -> list[np.ndarray]:
@@ -239,7 +257,7 @@ def read_corpus(path: Path) -> tuple[list[Goal], str]:
 
 def _known(c) -> bool:
     def has(kind: str, key: str, param: str) -> bool:
-        return key in NODES[kind] and param in NODES[kind][key].params
+        return key in nodes(kind) and param in nodes(kind)[key].params
 
     if not has("selector", c.sel, c.sp):
         return False
@@ -248,13 +266,15 @@ def _known(c) -> bool:
     return c.quant in QUANTS and has("relation", c.rel, c.rp)
 
 
-def load_prior(name: str) -> FittedPrior | None:
+def load_prior(name: str, language: int | None = None) -> FittedPrior | None:
     """``length`` / ``uniform``: None (the goal's own bits, or no prior); ``fitted``: the prior
-    shipped with the package (fitted to data/requests); ``file:PATH``: one written by `prior fit`."""
+    shipped with the package for language ``language`` (default: the one in force), fitted to
+    data/requests; ``file:PATH``: one written by `prior fit` (over the same language)."""
+    language = spoken() if language is None else check_language(language)
     if name in ("length", "uniform"):
         return None
     if name == "fitted":
-        text = resources.files("activeintent.goals").joinpath("priors", PACKAGED).read_text()
+        text = resources.files("activeintent.goals").joinpath("priors", PACKAGED[language]).read_text()
         return _cached(text, "the packaged fitted prior")
     if name.startswith("file:"):
         path = Path(name[5:])
@@ -262,7 +282,11 @@ def load_prior(name: str) -> FittedPrior | None:
             text = path.read_text()
         except OSError as err:
             raise PriorError(f"--prior {name}: cannot read {path}: {err.strerror or err}") from None
-        return _cached(text, str(path))
+        prior = _cached(text, str(path))
+        if prior.language != language:
+            raise PriorError(f"--prior {name}: fitted over language {prior.language}, the run speaks language "
+                             f"{language}; fit it again with `activeintent prior fit`")
+        return prior
     raise PriorError(f"unknown prior {name!r}; valid priors: length, uniform, fitted, file:PATH")
 
 

@@ -16,7 +16,7 @@ import re
 from collections import Counter
 from functools import cache, lru_cache
 
-from activeintent.goals.language import NODES, Goal, all_clauses
+from activeintent.goals.language import NODES, Goal, all_clauses, nodes, spoken
 
 MIN_SCORE = 0.45
 STOP = {"the", "a", "an", "is", "are", "be", "should", "to", "of", "on", "in", "and", "it", "its", "their",
@@ -124,14 +124,15 @@ def language_summary(examples: int = 12) -> dict:
     from activeintent.learners.lang.space import goal_space, space_info
 
     kinds = {}
-    for kind, nodes in NODES.items():
+    for kind in NODES:
         kinds[kind] = [{"key": k, "choices": len(node.params), "bits": round(node.bits(), 2),
                         "params": list(node.params[:6]) + (["…"] if len(node.params) > 6 else [])}
-                       for k, node in nodes.items()]
+                       for k, node in nodes(kind).items()]
     info = space_info(0, KEEP)
     goals = goal_space(0, KEEP)
     step = max(1, len(goals) // max(examples, 1))
     return {
+        "language": spoken(),
         "grammar": ["goal → clause [& clause [& clause]] [& every other block stays]",
                     "clause → quantifier selector relation | structure selector",
                     "quantifier → every | none | (exactly | at-least) (1 | 2)",

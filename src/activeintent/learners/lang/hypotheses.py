@@ -18,7 +18,7 @@ import numpy as np
 
 from activeintent.goals import planner
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import Goal
+from activeintent.goals.language import Goal, check_language, speaking, spoken
 from activeintent.goals.prior import FittedPrior, goal_bits, load_prior
 from activeintent.intentions.base import Intention
 from activeintent.learners.bayes.hypotheses import Hypothesis, random_scene
@@ -30,16 +30,19 @@ from activeintent.world import Scene, Skill, WorldState
 class LangSpace:
     """A tuple of goals, their shared vectorised judge and the planner verdicts so far."""
 
-    def __init__(self, goals: list[Goal] | tuple[Goal, ...], variants: int = 2, prior: FittedPrior | None = None):
+    def __init__(self, goals: list[Goal] | tuple[Goal, ...], variants: int = 2, prior: FittedPrior | None = None,
+                 language: int | None = None):
         self.goals = tuple(goals)
         self.prior = prior  # None: the length prior (each goal's own bits)
+        self.language = spoken() if language is None else language  # the version its bits are in
         self.compiled = Compiled(list(self.goals))
         self.variants = variants
         self.failed: dict[tuple[str, ...], set[int]] = {}
         self._feasible: dict[tuple[str, ...], tuple[int, np.ndarray]] = {}
         # by (goal, variants, exact positions): plans are a pure function of them, shared by episodes
         self._plans: BoundedCache[tuple, list[list[Skill]]] = BoundedCache(20000)
-        self.hypotheses = tuple(LangHypothesis(g, self, i) for i, g in enumerate(self.goals))
+        with speaking(self.language):
+            self.hypotheses = tuple(LangHypothesis(g, self, i) for i, g in enumerate(self.goals))
 
     def feasible(self, objects: tuple[str, ...]) -> np.ndarray:
         failed = self.failed.get(objects, set())
@@ -152,14 +155,16 @@ class GoalIntention(Intention):
         return planner.plan(self.goal, state)
 
 
-_SPACES: dict[tuple[int, int, str], LangSpace] = {}
+_SPACES: dict[tuple[int, int, str, int], LangSpace] = {}
 
 
-def lang_space(seed: int = 0, keep: int = 3000, prior: str = "length") -> LangSpace:
-    """The language's de-duplicated hypothesis space: the ``keep`` most probable distinct goals
-    under ``prior`` (length, fitted or file:PATH; built once per process, cached on disk)."""
-    fitted = load_prior(prior)
-    key = (seed, keep, fitted.tag if fitted else "length")
+def lang_space(seed: int = 0, keep: int = 3000, prior: str = "length", language: int | None = None) -> LangSpace:
+    """The de-duplicated hypothesis space of language ``language`` (default: the one in force):
+    the ``keep`` most probable distinct goals under ``prior`` (length, fitted or file:PATH; built
+    once per process, cached on disk)."""
+    language = spoken() if language is None else check_language(language)
+    fitted = load_prior(prior, language)
+    key = (seed, keep, fitted.tag if fitted else "length", language)
     if key not in _SPACES:
-        _SPACES[key] = LangSpace(goal_space(seed, keep, fitted), prior=fitted)
+        _SPACES[key] = LangSpace(goal_space(seed, keep, fitted, language), prior=fitted, language=language)
     return _SPACES[key]

@@ -13,7 +13,7 @@ import numpy as np
 from pydantic import Field
 
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import Goal
+from activeintent.goals.language import LATEST, Goal, speaking
 from activeintent.goals.prior import goal_bits
 from activeintent.learners.base import LearnerContext, Method, RoundRecord
 from activeintent.learners.bayes.judge import HypothesisJudge, trajectory_steps, utility
@@ -85,6 +85,7 @@ class LangConfig(BayesConfig):
     prior: str = Field("length", pattern="^(length|uniform|fitted|file:.+)$",  # type: ignore[assignment]
                        description="length: P(z) ∝ 2^-L(z); fitted: fitted to data/requests (goals/prior.py); "
                        "file:PATH: written by `prior fit`; uniform: the ablation")
+    language: int = Field(LATEST, description="the goal language's version (goals/language.py LANGUAGES)")
 
     rejuvenate_top: int = Field(8, ge=0, description="after each answer, neighbours of this many likely goals join")
     join_partners: int = Field(32, ge=0, description="... and each of them joined with each of this many likely goals")
@@ -98,7 +99,7 @@ class LangLearner(BayesLearner):
     def __init__(self, signal, rng=None, llm=None, config: LangConfig | None = None,
                  hypotheses: tuple[LangHypothesis, ...] | None = None, keep: int = KEEP):
         config = config or LangConfig()
-        hyps = tuple(hypotheses or lang_space(0, keep, config.prior).hypotheses)
+        hyps = tuple(hypotheses or lang_space(0, keep, config.prior, config.language).hypotheses)
         super().__init__(signal, rng, None, config, hyps)
         self.config: LangConfig = config
         self.llm = llm
@@ -110,7 +111,8 @@ class LangLearner(BayesLearner):
             sp.reset()  # the shared space keeps no planner verdicts from an earlier episode
         self.base = spaces
         self.prior = spaces[0].prior if spaces else None  # the goals' prior (None: length)
-        self.added = LangSpace([], prior=self.prior)  # goals that joined during this episode
+        self.language = spaces[0].language if spaces else config.language  # what it enumerates and charges
+        self.added = LangSpace([], prior=self.prior, language=self.language)  # goals that joined during this episode
         self.judge = LangJudge(self.base)
         self.keys = {h.name for h in hyps}
         self.cut = max(h.bits for h in hyps) + 1e-9  # the starting space holds every distinct goal up to here
@@ -128,8 +130,8 @@ class LangLearner(BayesLearner):
         if not fresh:
             return []
         n_old = len(self.added.goals)
-        self.added = LangSpace(list(self.added.goals) + fresh, prior=self.prior)
-        new_space = LangSpace(fresh, prior=self.prior)  # scored alone, then merged: the judge below is temporary
+        self.added = LangSpace(list(self.added.goals) + fresh, prior=self.prior, language=self.language)
+        new_space = LangSpace(fresh, prior=self.prior, language=self.language)  # scored alone, then merged: the judge below is temporary
         log_lik = self._log_lik(LangJudge(new_space))
         self.judge = LangJudge(self.base + [self.added])
         self.belief.extend(self.added.hypotheses[n_old:], log_lik)
@@ -139,13 +141,16 @@ class LangLearner(BayesLearner):
 
     def bits(self, goal: Goal) -> float:
         """L(z) under the learner's prior."""
-        return goal_bits(goal, self.prior)
+        with speaking(self.language):
+            return goal_bits(goal, self.prior)
 
     def _rejuvenate(self) -> int:
         if not self.config.rejuvenate_top:
             return 0
         likely = [h.goal for h, _ in self.top(self.config.join_partners)]  # type: ignore[attr-defined]
-        added = self._admit(neighbours(likely[:self.config.rejuvenate_top], likely))
+        with speaking(self.language):
+            near = neighbours(likely[:self.config.rejuvenate_top], likely)
+        added = self._admit(near)
         self.growth["neighbours"] += len(added)
         return len(added)
 
@@ -159,8 +164,9 @@ class LangLearner(BayesLearner):
         try:
             # the request's seed is not drawn from the learner's generator: asking the model must
             # not change which queries follow, so runs with and without --llm stay paired
-            goals, answered = propose_goals(self.llm, likely, history, self.config.proposals_per_call,  # type: ignore[arg-type]
-                                            seed=len(self.observations))
+            with speaking(self.language):
+                goals, answered = propose_goals(self.llm, likely, history, self.config.proposals_per_call,  # type: ignore[arg-type]
+                                                seed=len(self.observations))
         except ModelError as err:
             self.proposal_errors.append(str(err)[:300])
             return []
@@ -204,7 +210,8 @@ def lang_method(signal: str) -> Method:
 
     def build(ctx: LearnerContext) -> LangLearner:
         return LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm,
-                           config=LangConfig(prior=ctx.config.prior, scenes=ctx.config.scenes))  # type: ignore[arg-type]
+                           config=LangConfig(prior=ctx.config.prior, scenes=ctx.config.scenes,  # type: ignore[arg-type]
+                                             language=ctx.config.language))
 
     return Method(signal, False, build, f"ours: growing belief over the goal language, {signal} queries by EIG",
                   goal_language=True)
@@ -215,7 +222,7 @@ def lang_zero_signal() -> Method:
     lang-* under the same prior)."""
 
     def build(ctx: LearnerContext) -> LangLearner:
-        learner = LangLearner("stop", rng=ctx.learner_seed, config=LangConfig(prior=ctx.config.prior))  # type: ignore[arg-type]
+        learner = LangLearner("stop", rng=ctx.learner_seed, config=LangConfig(prior=ctx.config.prior, language=ctx.config.language))  # type: ignore[arg-type]
         learner.asks = False
         learner.name = "lang-zero-signal"
         return learner

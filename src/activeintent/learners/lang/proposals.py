@@ -24,14 +24,14 @@ from typing import Literal
 
 from pydantic import BaseModel, Field, create_model
 
-from activeintent.goals.language import MAX_CLAUSES, NODES, QUANTS, Each, Form, Goal
+from activeintent.goals.language import MAX_CLAUSES, QUANTS, Each, Form, Goal, nodes
 from activeintent.llm.base import ChatModel, Message
 
 
 def _swap_params(c):
     """Clauses differing from ``c`` in one choice (quantifier, selector, relation/structure parameter)."""
     out = []
-    for sel, node in NODES["selector"].items():
+    for sel, node in nodes("selector").items():
         for sp in node.params:
             if (sel, sp) != (c.sel, c.sp):
                 out.append(Each(c.quant, sel, sp, c.rel, c.rp) if isinstance(c, Each) else Form(c.struct, c.stp, sel, sp))
@@ -83,9 +83,9 @@ def neighbours(goals: list[Goal], partners: list[Goal] | None = None) -> list[Go
 
 def _words() -> tuple[list[str], list[str]]:
     """The selector words and predicate words of the language (relations and structures)."""
-    selectors = [f"{k}:{p}" for k, n in NODES["selector"].items() for p in n.params]
-    predicates = [f"{k}:{p}" for k, n in NODES["relation"].items() for p in n.params]
-    predicates += [f"form {k}:{p}" for k, n in NODES["structure"].items() for p in n.params]
+    selectors = [f"{k}:{p}" for k, n in nodes("selector").items() for p in n.params]
+    predicates = [f"{k}:{p}" for k, n in nodes("relation").items() for p in n.params]
+    predicates += [f"form {k}:{p}" for k, n in nodes("structure").items() for p in n.params]
     return selectors, predicates
 
 

@@ -8,12 +8,14 @@ probe state whether it holds, per probe move whether the move goes against it; g
 same answers everywhere are one (the shortest is kept), goals that hold on no probe state are
 dropped (nothing could confirm them). The ``keep`` shortest distinct goals form the space
 the learner starts from (it grows while learning: proposals.py).
-The list is cached on disk under ``$ACTIVEINTENT_CACHE`` (default ``~/.cache/activeintent``),
-keyed by a hash of the sources it depends on and of the registered node types.
+The list is cached on disk under ``$ACTIVEINTENT_SPACE_CACHE`` (default ``$ACTIVEINTENT_CACHE``,
+then ``~/.cache/activeintent``), keyed by a hash of the sources it depends on, of the registered
+node types and of the language version.
 """
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import itertools
 import json
@@ -35,6 +37,8 @@ from activeintent.goals.language import (
     Placed,
     all_clauses,
     parse_goal,
+    speaking,
+    spoken,
     structure_judge,
 )
 from activeintent.goals.planner import generic_moves, plan
@@ -85,6 +89,11 @@ class Compiled:
         self.e_rel = np.array([rels[(c.rel, c.rp)] for c in each], int)
         self.e_q = np.array([Q_CODE[c.quant.rsplit("-", 1)[0] if c.quant[-1].isdigit() else c.quant] for c in each], int)
         self.e_n = np.array([int(c.quant[-1]) if c.quant[-1].isdigit() else 0 for c in each], int)
+        # conditional relations ("… if there is one"): per relation the object whose absence makes
+        # its clauses hold (None for the others)
+        self._rel_if = [NODES["relation"][r].refers(p) if NODES["relation"][r].vacuous_without_ref else None
+                        for r, p in self.rels]
+        self._has_if = any(r is not None for r in self._rel_if)
         self.f_sel = [sels[(clauses[i].sel, clauses[i].sp)] for i in self.forms]
         shapes: dict[tuple[str, str], int] = {}
         for i in self.forms:
@@ -167,12 +176,22 @@ class Compiled:
             szc = np.maximum(sz, 1)
             s = np.where(q == 0, cnt / szc, np.where(q == 1, 1 - cnt / szc, np.where(
                 q == 2, np.clip(1 - np.abs(cnt - m) / np.maximum(szc, m), 0, 1), np.minimum(cnt, m) / np.maximum(m, 1))))
+            if self._has_if:
+                absent = self._absent(f)
+                h = h | absent
+                s = np.where(absent, 1.0, s)
             holds[self.each] = h
             score[self.each] = s
         if self.forms:
             self._judge_forms(f, holds, score)
         got = f.memo[key] = (holds, score)
         return got
+
+    def _absent(self, f: Facts) -> np.ndarray:
+        """Per Each clause: does its conditional relation name an object absent from ``f``?"""
+        on = set(f.pos)
+        gone = np.array([r is not None and r not in on for r in self._rel_if], bool)
+        return gone[self.e_rel]
 
     def _form_groups(self, f: Facts) -> tuple[list[tuple[str, ...]], list[int]]:
         """The distinct groups the selectors pick in ``f`` and, per selector, its group's index."""
@@ -265,6 +284,8 @@ class Compiled:
                 cnt = C[self.e_sel, self.e_rel]
                 q = self.e_q
                 off[self.each] = ing & (((q == 0) & ~r) | ((q == 1) & r) | ((q == 2) & r & (cnt > self.e_n)))
+                if self._has_if:
+                    off[self.each] &= ~self._absent(fa)
                 inside[self.each] = ing
             if self.forms:
                 self._moved_forms(fb, fa, b, off, inside)
@@ -373,27 +394,43 @@ def cache_path(tag: str) -> Path:
     for kind, nodes in NODES.items():  # node types registered at run time (plug-ins) count too
         for key, node in nodes.items():
             digest.update(f"\0{kind}:{key}:{type(node).__module__}.{type(node).__qualname__}:{node.params}".encode())
-    root = Path(os.environ.get("ACTIVEINTENT_CACHE", Path.home() / ".cache" / "activeintent"))
+    default = os.environ.get("ACTIVEINTENT_CACHE", Path.home() / ".cache" / "activeintent")
+    root = Path(os.environ.get("ACTIVEINTENT_SPACE_CACHE", default))  # content-addressed: may be shared
     return root / f"lang-space-{digest.hexdigest()[:16]}-{tag}.json"
 
 
 def cached_json(path: Path, make: Callable[[], dict]) -> dict:
     """``make()``, kept at ``path``: read when there (and readable), else made and written
     atomically (a temporary file, then a rename: a reader never sees half a file); a cache that
-    cannot be written is skipped, never fatal."""
+    cannot be written is skipped, never fatal. Processes making the same file take turns (a
+    lock beside it): the second reads what the first made (bench workers, test workers)."""
     try:
         return json.loads(path.read_text())
     except (OSError, ValueError):
         pass
-    value = make()
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(json.dumps(value))
-        os.replace(tmp, path)
+        lock = open(path.with_suffix(".lock"), "w")  # noqa: SIM115 - held until made
     except OSError:
-        pass
-    return value
+        lock = None
+    try:
+        if lock is not None:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            try:
+                return json.loads(path.read_text())
+            except (OSError, ValueError):
+                pass
+        value = make()
+        try:
+            tmp = path.with_suffix(f".{os.getpid()}.tmp")
+            tmp.write_text(json.dumps(value))
+            os.replace(tmp, path)
+        except OSError:
+            pass
+        return value
+    finally:
+        if lock is not None:
+            lock.close()
 
 
 def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scenes: int = 40,
@@ -414,14 +451,18 @@ def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scen
     n = len(clauses)
     P = np.array([comp.possible(objs)[:n] for objs in scenes]).T  # [clause, scene]
     H = np.zeros((n, len(states)), bool)
+    # The per-clause verdicts a state's memo keeps are MBs each with 10^5 clauses: dropped once
+    # copied, as the bank's thousands of states would otherwise hold them all at once.
     for k, (si, f) in enumerate(states):
         H[:, k] = comp.clause_eval(f)[0][:n] & P[:, si]
+        f.memo.pop(comp._tag + ("c",), None)
     Off = np.zeros((n, len(moves)), bool)
     In = np.zeros((n, len(moves)), bool)
     for k, (si, fb, fa, b) in enumerate(moves):
         off, inside = comp.clause_moved(fb, fa, b)
         Off[:, k] = off[:n] & P[:, si]
         In[:, k] = inside[:n] & P[:, si]
+        fa.memo.pop(comp._tag + ("o", b), None)
     state_scene = np.array([si for si, _ in states])
     move_scene = np.array([si for si, *_ in moves])
     generated = 0
@@ -469,15 +510,28 @@ def build_space(seed: int = 0, keep: int = 3000, pair_bits: float = 13.2, n_scen
             "probe_moves": len(moves), "seconds": round(time.time() - t0, 1)}
 
 
-def space_info(seed: int = 0, keep: int = 3000, prior: FittedPrior | None = None) -> dict:
-    """The built space (from the disk cache when the sources and the prior have not changed)."""
+def space_info(seed: int = 0, keep: int = 3000, prior: FittedPrior | None = None, language: int | None = None) -> dict:
+    """The built space of language ``language`` (default: the one in force), from the disk cache
+    when the sources and the prior have not changed."""
+    language = spoken() if language is None else language
     tag = f"{seed}-{keep}" if prior is None else f"{seed}-{keep}-{prior.tag}"
-    return cached_json(cache_path(tag), lambda: build_space(seed, keep, prior=prior))
+    tag += f"-v{language}"
+
+    def make() -> dict:
+        with speaking(language):
+            return build_space(seed, keep, prior=prior)
+
+    return cached_json(cache_path(tag), make)
+
+
+def goal_space(seed: int = 0, keep: int = 3000, prior: FittedPrior | None = None,
+               language: int | None = None) -> tuple[Goal, ...]:
+    return _goal_space(seed, keep, prior, spoken() if language is None else language)
 
 
 @lru_cache(maxsize=4)
-def goal_space(seed: int = 0, keep: int = 3000, prior: FittedPrior | None = None) -> tuple[Goal, ...]:
-    return tuple(parse_goal(k) for k in space_info(seed, keep, prior)["keys"])
+def _goal_space(seed: int, keep: int, prior: FittedPrior | None, language: int) -> tuple[Goal, ...]:
+    return tuple(parse_goal(k) for k in space_info(seed, keep, prior, language)["keys"])
 
 
 __all__ = ["QUANTS", "Compiled", "build_space", "goal_space", "kind_of", "probe_bank", "space_info"]
