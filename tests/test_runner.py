@@ -43,7 +43,7 @@ def containers(obj, seen=None):
 def small_lang_space(monkeypatch):
     """lang-* learners start from a handful of goals (the wiring is the same, the build is instant)."""
     goals = [Goal((Each(q, "all", "", "in-bowl", p),)) for q in ("every", "none") for p in ("any", "same")]
-    monkeypatch.setattr(lang_learner, "lang_space", lambda seed=0, keep=0, prior="length": LangSpace(goals))
+    monkeypatch.setattr(lang_learner, "lang_space", lambda seed=0, keep=0, prior="length", language=None: LangSpace(goals))
 
 
 @pytest.mark.parametrize("user", ["human", "paper"])

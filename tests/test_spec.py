@@ -11,7 +11,8 @@ from activeintent.spec import OPTIONS, EpisodeSeeds, RunSpec
 def test_every_option_lands_in_its_section_and_reads_back():
     changed = {"method": "lang-stop", "intention": "stack", "intention_file": None, "plugins": ["x.py"],
                "budget": 7, "seed": 3, "test_seed": 9, "test_scenes": 4, "test_pool": 5, "env": "symbolic",
-               "user": "paper", "new_scene": "free", "prior": "uniform", "scenes": "belief", "llm": "none", "vlm": "openai:v",
+               "user": "paper", "new_scene": "free", "prior": "uniform", "scenes": "belief", "language": 1, "llm": "none",
+               "vlm": "openai:v",
                "base_url": "http://h", "cache": "c.sqlite", "cache_mode": "off", "executor": "parse",
                "retriever": "vision", "epsilon": 1.5, "early_threshold": 0.5, "variant": "structured",
                "design_scenes": False, "video": "all", "curve": False, "stop_when_done": True}

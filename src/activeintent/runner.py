@@ -13,7 +13,7 @@ from typing import Any
 from activeintent.episode import Episode
 from activeintent.spec import DEFAULT_INTENTION, DEFAULT_METHOD, ModelsConfig, RunSpec
 
-__all__ = ["DEFAULT_INTENTION", "DEFAULT_METHOD", "Models", "RunSpec", "build_episode", "check_spec"]
+__all__ = ["DEFAULT_INTENTION", "DEFAULT_METHOD", "Models", "RunSpec", "build_episode", "check_spec", "with_method_defaults"]
 
 
 EXECUTOR_CTX = 8192  # the planner's prompts are ~750 tokens and its answers short
@@ -74,6 +74,19 @@ class Models:
         return float(sum(x.latency_s for x in self._totals()))
 
 
+def with_method_defaults(spec: RunSpec) -> RunSpec:
+    """The spec with the method's own value where it leaves a setting open (the prior), so that
+    what a record keeps is what ran."""
+    if spec.learner.prior is not None:
+        return spec
+    from activeintent.learners.registry import get_method
+    from activeintent.registry import load_plugin
+
+    for path in spec.plugins:
+        load_plugin(path)
+    return spec.with_options(prior=get_method(spec.learner.method).default_prior)
+
+
 def check_spec(spec: RunSpec) -> None:
     """Refuse, before any work, a spec that cannot run; messages name the option and list choices."""
     from activeintent.act.executors import EXECUTORS
@@ -86,6 +99,7 @@ def check_spec(spec: RunSpec) -> None:
     for path in spec.plugins:
         load_plugin(path)
     method = get_method(spec.learner.method)
+    spec = with_method_defaults(spec)
     if spec.learner.prior not in ("length", "uniform"):
         from activeintent.goals.prior import load_prior
 
@@ -121,6 +135,7 @@ def build_episode(
     from activeintent.users.simulated import SimulatedUser, user_profile
 
     check_spec(spec)
+    spec = with_method_defaults(spec)
     learning, who = spec.learner, spec.user
     method = get_method(learning.method)
     intention = resolve_intention(who.intention or (None if who.intention_file else DEFAULT_INTENTION),

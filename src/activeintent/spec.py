@@ -98,8 +98,9 @@ class LearnerConfig(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     method: str = DEFAULT_METHOD
-    prior: str = Field("length", pattern="^(length|uniform|fitted|file:.+)$",
-                       description="length | uniform | fitted (lang-* only) | file:PATH (lang-*, from `prior fit`)")
+    prior: str | None = Field(None, pattern="^(length|uniform|fitted|file:.+)$",
+                              description="length | uniform | fitted (lang-* only) | file:PATH (lang-*, from `prior fit`) | "
+                              "None: the method's own (lang-*: fitted, the others: length)")
     scenes: str = Field("sampled", pattern="^(sampled|belief)$",
                         description="bayes-* and lang-*: sampled scenes, or scenes the belief expects to show z")
     language: int = Field(LATEST, description="lang-*: the goal language's version (recorded, so that an episode "

@@ -97,7 +97,7 @@ def protocol_fields(run: RunSpec) -> dict:
     """What every results line records about how it was measured."""
     p, learner = run.protocol, run.learner
     return {"env": run.env.name, "user_preset": run.user.preset, "budget": p.budget, "new_scene": p.new_scene,
-            "prior": learner.prior, "test_scenes": p.test_scenes, "test_pool": p.test_pool, "llm": run.models.llm,
+            "prior": learner.prior or "per method (lang-*: fitted, others: length)", "test_scenes": p.test_scenes, "test_pool": p.test_pool, "llm": run.models.llm,
             "executor": learner.executor, "vlm": run.models.vlm, "retriever": learner.retriever,
             "variant": learner.variant}
 
@@ -109,6 +109,9 @@ def run_item(item: WorkItem, options: RunSpec, bench_seed: int, out: str, keep: 
     run = options.with_options(method=item.method, intention=None if user_defined else item.intention,
                                intention_file=item.intention if user_defined else None,
                                seed=seed, test_seed=test_seed)
+    from activeintent.runner import with_method_defaults
+
+    run = with_method_defaults(run)  # the prior the method ran with, in every line
     base = {"method": item.method, "intention": item.intention, "trial": item.trial, **protocol_fields(run)}
     try:
         from activeintent.runner import build_episode

@@ -115,6 +115,12 @@ class Method:
     family: str = "ours"  # paper | ours | baseline
     goal_language: bool = False  # its hypotheses are goals of the language: --prior fitted / file: apply
 
+    @property
+    def default_prior(self) -> str:
+        """Its prior when ``--prior`` is not given: the goal language's learners take the prior
+        fitted to what people ask (chosen on dev: experiments/defaults), the others length."""
+        return "fitted" if self.goal_language else "length"
+
     def __call__(self, ctx: LearnerContext) -> Learner:
         if self.needs_llm and ctx.llm is None:
             raise ValueError("this method needs a language model (--llm embedded, gguf:…, openai:…)")
