@@ -323,7 +323,7 @@ def decide_method(signal: str, name: str | None = None, keep: int = KEEP, descri
         return learner
 
     return Method(signal, False, build, description or f"experiment: the goal-language belief, scenes designed "
-                  f"from it, {signal} queries by information about the decision")
+                  f"from it, {signal} queries by information about the decision", goal_language=True)
 
 
 for _signal in ("stop", "preference"):

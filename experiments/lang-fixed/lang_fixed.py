@@ -17,7 +17,8 @@ def _fixed(signal: str) -> Method:
         learner.name = f"lang-fixed-{signal}"
         return learner
 
-    return Method(signal, False, build, f"ablation: lang-{signal} without neighbours joining the belief")
+    return Method(signal, False, build, f"ablation: lang-{signal} without neighbours joining the belief",
+                  goal_language=True)
 
 
 for _signal in ("stop", "preference"):

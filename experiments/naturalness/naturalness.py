@@ -129,7 +129,7 @@ def _method(variant: str, signal: str) -> Method:
     name = f"lang-{variant}-{signal}"
     return Method(signal, False, lambda ctx: natural_learner(signal, weight, ctx, name),
                   f"ablation: lang-{signal} with a language model's naturalness in the prior "
-                  f"(λ = {'sd(L) / sd(N)' if weight is None else weight})")
+                  f"(λ = {'sd(L) / sd(N)' if weight is None else weight})", goal_language=True)
 
 
 for _variant in WEIGHTS:

@@ -44,7 +44,7 @@ def test_the_experiment_runs_one_episode(plugin, tmp_path):
     spec = RunSpec.from_options(method=method, intention=intention, intention_file=intention_file,
                                 plugins=[str(EXPERIMENTS / plugin)], env="symbolic", llm="none", budget=2,
                                 test_scenes=3, test_pool=0, video="none", seed=1,
-                                language=1)  # the language the findings were measured in
+                                language=1, prior="length")  # what the findings were measured in
     result = build_episode(spec, tmp_path).run()
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["method"] == method and summary["signals_used"] == 2

@@ -51,7 +51,17 @@ class Plan:
         self.trials = options.trials
         self.seed = options.seed
         self.budget = options.run.protocol.budget
-        self.fields = protocol_fields(options.run)
+        self.run = options.run
+        self._fields: dict[str, dict] = {}
+
+    def fields(self, method: str) -> dict:
+        """The settings a line of ``method`` records (its own prior where the folder leaves it open)."""
+        got = self._fields.get(method)
+        if got is None:
+            from activeintent.runner import with_method_defaults
+
+            got = self._fields[method] = protocol_fields(with_method_defaults(self.run.with_options(method=method)))
+        return got
 
     def __call__(self, record: dict) -> tuple[str, str] | None:
         return self.problem(record)
@@ -69,7 +79,7 @@ class Plan:
         if t >= self.trials:
             return "plan", f"trial {t} is past this folder's {self.trials} trial(s) (0 to {self.trials - 1})"
         changed = [f"{k} {rec.get(k, '(missing)')!r} (planned {v!r})"
-                   for k, v in self.fields.items() if rec.get(k, _MISSING) != v]
+                   for k, v in self.fields(m).items() if rec.get(k, _MISSING) != v]
         if changed:
             return "plan", "not made with this folder's settings: " + "; ".join(changed)
         seed, test_seed = trial_seeds(self.seed, i, t)

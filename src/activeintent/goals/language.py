@@ -1978,7 +1978,3 @@ def all_clauses() -> list[Clause]:
                 for stp in stnode.params:
                     out.append(Form(st, stp, sel, sp))
     return out
-
-
-# Language 2's node types register last: their module builds on this one.
-from activeintent.goals import requested as _requested  # noqa: E402,F401

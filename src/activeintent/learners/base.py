@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from pydantic import BaseModel, Field
 
@@ -124,4 +124,6 @@ class Method:
     def __call__(self, ctx: LearnerContext) -> Learner:
         if self.needs_llm and ctx.llm is None:
             raise ValueError("this method needs a language model (--llm embedded, gguf:…, openai:…)")
+        if ctx.config.prior is None:  # the spec leaves it to the method
+            ctx = replace(ctx, config=ctx.config.model_copy(update={"prior": self.default_prior}))
         return self.build(ctx)

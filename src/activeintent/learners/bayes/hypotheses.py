@@ -381,7 +381,8 @@ def _cache_sources() -> list[Path]:
     recipes its leaves are (and the facts, placing helpers and node registry they are built on),
     all of world/, intentions/."""
     pkg = Path(__file__).resolve().parents[2]
-    goals = [pkg / "goals" / name for name in ("facts.py", "language.py", "planning.py", "recipes.py")]
+    goals = [pkg / "goals" / name for name in ("__init__.py", "facts.py", "language.py", "planning.py", "recipes.py",
+                                                "requested.py")]
     return [pkg / "learners" / "bayes" / "hypotheses.py", *goals, pkg / "registry.py", pkg / "memo.py",
             *sorted((pkg / "world").glob("*.py")), *sorted((pkg / "intentions").glob("*.py"))]
 
