@@ -251,7 +251,9 @@ def test_the_bench_reads_the_belief_on_a_hidden_goal_without_telling_the_learner
     from activeintent.runner import RunSpec, build_episode
 
     options = RunSpec.from_options(method="decide-stop", intention="truth-03", env="symbolic", llm="none", video="none",
-                         budget=2, seed=1, test_scenes=1, test_pool=0)
+                         budget=2, seed=1, test_scenes=1, test_pool=0, prior="length",
+                         language=1)  # decide's findings' settings; the truth goals are language 1's
+    assert options.learner.language == 1
     episode = build_episode(options)
     key = episode.intention.goal.key
     prior = episode.learner.mass_of(key)
