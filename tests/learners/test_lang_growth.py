@@ -57,6 +57,21 @@ def test_neighbours_are_one_move_away_and_parse_back():
         assert parse_goal(key) == n
 
 
+def test_a_set_of_colours_is_one_move_per_colour_away():
+    """Picking two colours is two choices: a pair is reached from a selector naming one of them."""
+    def selectors(clause):
+        return {(n.clauses[0].sel, n.clauses[0].sp) for n in neighbours([Goal((clause,))]) if len(n.clauses) == 1}
+
+    red = selectors(Each("every", "colour", "red", "in-bowl", "any"))
+    assert ("colours", "red+green") in red and ("all-but-colours", "green+yellow") not in red
+    assert not any(sel == "colours" and "red" not in sp.split("+") for sel, sp in red)
+    every = selectors(Each("every", "all", "", "in-bowl", "any"))
+    assert ("colour", "red") in every and not any(sel.endswith("colours") for sel, _ in every)
+    pair = selectors(Each("every", "colours", "blue+red", "in-bowl", "any"))
+    assert {("colour", "blue"), ("colours", "red+green"), ("all-but-colours", "blue+red")} <= pair
+    assert ("colours", "green+yellow") not in pair
+
+
 def test_a_conjunction_left_out_of_the_space_joins_it_scored_on_every_answer():
     """The true goal (two clauses) is not in the starting space, its clauses are: after ten
     answers of an exact user it is in the belief with exactly prior × likelihood of every

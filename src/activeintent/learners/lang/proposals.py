@@ -5,7 +5,7 @@ their likelihood on every answer so far, so the posterior is the one over the la
 nothing is accepted on a model's word.
 
 - :func:`neighbours` — rejuvenation moves on expressions: change a clause's quantifier,
-  selector or relation parameter, toggle "everything else stays", drop a clause, or join two
+  selector (one colour of a set of colours at a time) or relation parameter, toggle "everything else stays", drop a clause, or join two
   likely goals into one conjunction (≤ ``MAX_CLAUSES`` clauses). Applied to the most probable
   goals after every answer, they reach goals the enumerated space left out (long conjunctions).
 - :func:`propose_goals` — a language model reads the history h and the likely goals and
@@ -26,13 +26,25 @@ from pydantic import BaseModel, Field, create_model
 
 from activeintent.goals.language import MAX_CLAUSES, QUANTS, Each, Form, Goal, nodes
 from activeintent.llm.base import ChatModel, Message
+from activeintent.world.colors import COLOR_NAMES
+
+
+def _colours(param: str) -> frozenset[str]:
+    """The colour names a selector's parameter says ("red", "blue+red")."""
+    return frozenset(COLOR_NAMES).intersection(param.split("+"))
 
 
 def _swap_params(c):
-    """Clauses differing from ``c`` in one choice (quantifier, selector, relation/structure parameter)."""
+    """Clauses differing from ``c`` in one choice (quantifier, selector, relation/structure
+    parameter). A selector of several named colours is one choice away only from a selector
+    naming one of them: picking a set of colours is one choice per colour."""
     out = []
+    near = _colours(c.sp)
     for sel, node in nodes("selector").items():
         for sp in node.params:
+            named = _colours(sp)
+            if len(named) > 1 and not named & near:
+                continue
             if (sel, sp) != (c.sel, c.sp):
                 out.append(Each(c.quant, sel, sp, c.rel, c.rp) if isinstance(c, Each) else Form(c.struct, c.stp, sel, sp))
     if isinstance(c, Each):
