@@ -87,8 +87,9 @@ def with_method_defaults(spec: RunSpec) -> RunSpec:
     return spec.with_options(prior=get_method(spec.learner.method).default_prior)
 
 
-def check_spec(spec: RunSpec) -> None:
-    """Refuse, before any work, a spec that cannot run; messages name the option and list choices."""
+def check_spec(spec: RunSpec) -> RunSpec:
+    """Refuse, before any work, a spec that cannot run; messages name the option and list choices.
+    Returns the spec that will run (the method's defaults filled in: :func:`with_method_defaults`)."""
     from activeintent.act.executors import EXECUTORS
     from activeintent.envs import ENVS
     from activeintent.learners.registry import get_method
@@ -106,7 +107,7 @@ def check_spec(spec: RunSpec) -> None:
         if not method.goal_language:
             raise ValueError(f"--prior {spec.learner.prior}: a fitted prior is over the goal language; "
                              f"{spec.learner.method} takes length or uniform (lang-* take fitted and file:PATH)")
-        load_prior(spec.learner.prior)  # a missing or malformed file is refused before any work
+        load_prior(spec.learner.prior, spec.learner.language)  # a missing, malformed or other-language file is refused before any work
     ENVS.check(spec.env.name)
     USER_PRESETS.check(spec.user.preset)
     if method.needs_llm and spec.models.llm == "none":
@@ -116,6 +117,7 @@ def check_spec(spec: RunSpec) -> None:
     for model in (spec.models.llm, spec.models.vlm):
         if model not in (None, "none"):
             parse_spec(model)  # a typo in a model spec is refused before any work
+    return spec
 
 
 def build_episode(
@@ -134,8 +136,7 @@ def build_episode(
     from activeintent.suites import resolve as resolve_intention
     from activeintent.users.simulated import SimulatedUser, user_profile
 
-    check_spec(spec)
-    spec = with_method_defaults(spec)
+    spec = check_spec(spec)
     learning, who = spec.learner, spec.user
     method = get_method(learning.method)
     intention = resolve_intention(who.intention or (None if who.intention_file else DEFAULT_INTENTION),

@@ -149,3 +149,30 @@ def test_the_committed_coverage_comes_out_of_the_code():
             again = cov.coverage(resolve(name), start_keys=cov.start_space_keys()).row()
         assert {k: again[k] for k in ("goal", "success", "selection_success", "bits", "prior_rank")} == {
             k: rows[name][k] for k in ("goal", "success", "selection_success", "bits", "prior_rank")}, name
+
+
+def test_the_search_keeps_each_states_verdicts_and_counts_exactly():
+    """Packed verdicts and running counts equal the clauses judged afresh on every state."""
+    from activeintent.goals.language import Goal, all_clauses
+    from activeintent.learners.lang.space import Compiled
+
+    it = OnAStrip()
+    scenes = cov.feasible_scenes(it, 3, 0, "selection")
+    trials = cov._bank(it, scenes, np.random.default_rng(0))
+    clauses = sorted(all_clauses(), key=lambda c: (c.bits, c.key))[:3000]
+    search = cov.Search(it, trials, clauses)
+    judge = Compiled([Goal((c,)) for c in clauses])
+    dense, labels = [], []
+    for t in trials:
+        possible = judge.possible(tuple(t.scene.objects))[: len(clauses)]
+        seen = {}
+        for s in t.states:
+            seen.setdefault(tuple(sorted(s.positions.items())), s)
+        for s in seen.values():
+            dense.append(judge.clause_eval(facts(s))[0][: len(clauses)] & possible)
+            labels.append(bool(it.satisfied(s)))
+    H, y = np.array(dense).T, np.array(labels)
+    rows = np.arange(len(clauses))
+    assert H.shape[1] == len(search.labels) and (search.y == y).all()
+    assert (search.holds(rows) == H).all()
+    assert (search.tp == H[:, y].sum(1)).all() and (search.fp == H[:, ~y].sum(1)).all()

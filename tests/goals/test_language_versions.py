@@ -58,7 +58,7 @@ def test_a_record_written_before_the_language_grew_replays_in_language_1():
 
 def test_a_language_1_learner_never_admits_a_goal_of_language_2():
     with speaking(1):
-        start = [parse_goal(k) for k in ("every all: in-bowl:same", "form tower:any all:", "every class:warm on-table:")]
+        start = [parse_goal(k) for k in ("every all: in-bowl:same", "form tower:any all:", "every colour:red on-table:")]
     space = LangSpace(start, language=1)
     learner = LangLearner("stop", rng=0, config=LangConfig(language=1, rejuvenate_top=3, join_partners=3),
                           hypotheses=space.hypotheses)

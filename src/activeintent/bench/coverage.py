@@ -164,7 +164,12 @@ def _bank(intention: Intention, scenes: list[tuple[Scene, int]], rng: np.random.
 
 
 class Search:
-    """The clause judge and the labelled bank of one intention."""
+    """The clause judge and the labelled bank of one intention.
+
+    Per clause it keeps only what ranking needs: how many satisfied and unsatisfied states it
+    holds on, and each state's verdicts packed to bits (a pair's counts are read from the
+    clauses that may pair), so a language of 10^5 clauses fits in memory and each state is
+    judged once."""
 
     def __init__(self, intention: Intention, trials: list[Trial], clauses):
         self.intention = intention
@@ -173,41 +178,51 @@ class Search:
         self.comp = Compiled([Goal((c,)) for c in clauses])
         self.n = len(clauses)
         self.P = np.array([self.comp.possible(tuple(t.scene.objects))[: self.n] for t in trials]).T  # [clause, scene]
-        self.H = np.zeros((self.n, 0), bool)
-        self.y = np.zeros(0, bool)
+        self.tp = np.zeros(self.n, np.int64)  # satisfied states the clause holds on
+        self.fp = np.zeros(self.n, np.int64)  # unsatisfied states it holds on
+        self.columns: list[np.ndarray] = []  # per state: the clauses' verdicts, packed to bits
+        self.labels: list[bool] = []
         self.seen: set[tuple] = set()
         for k, t in enumerate(trials):
             self.add(k, t.states)
 
+    @property
+    def y(self) -> np.ndarray:
+        return np.array(self.labels, bool)
+
     def add(self, k: int, states) -> None:
-        cols, labels = [], []
         for s in states:
             key = (k, tuple(sorted(s.positions.items())))
             if key in self.seen:
                 continue
             self.seen.add(key)
-            f = facts(s)
-            cols.append(self.comp.clause_eval(f)[0][: self.n] & self.P[:, k])
-            labels.append(bool(self.intention.satisfied(s)))
-        if cols:
-            self.H = np.concatenate([self.H, np.array(cols).T], axis=1)
-            self.y = np.concatenate([self.y, np.array(labels, bool)])
+            col = self.comp.clause_eval(facts(s))[0][: self.n] & self.P[:, k]
+            label = bool(self.intention.satisfied(s))
+            (self.tp if label else self.fp)[col] += 1
+            self.columns.append(np.packbits(col))
+            self.labels.append(label)
+
+    def holds(self, rows: np.ndarray) -> np.ndarray:
+        """The verdicts of clauses ``rows`` on every state so far: [row, state]."""
+        packed = np.array(self.columns)  # [state, byte]
+        return ((packed[:, rows // 8] >> (7 - rows % 8)[None, :]) & 1).astype(bool).T
 
     def ranked(self, exclude: set[str], n: int) -> list[Goal]:
         """The ``n`` goals (one clause or a pair) that best agree with the labels, not in ``exclude``:
         half by balanced agreement (goals that say what the intention says), half by precision
         (goals narrower than it — "all in the back left corner" for "all in one corner" — hold
         on few of its satisfied states but almost never where it fails)."""
-        pos, neg = self.y, ~self.y
+        y = self.y
+        pos, neg = y, ~y
         n_pos, n_neg = max(int(pos.sum()), 1), max(int(neg.sum()), 1)
-        Hp = self.H[:, pos].astype(np.int32)
-        Hn = self.H[:, neg].astype(np.int32)
         bits1 = np.array([c.bits for c in self.clauses])
-        order = np.lexsort((bits1, -Hp.sum(1)))[:PAIR_CLAUSES]  # clauses that may pair: most satisfied states
-        tp2, fp2 = Hp[order] @ Hp[order].T, Hn[order] @ Hn[order].T
+        order = np.lexsort((bits1, -self.tp))[:PAIR_CLAUSES]  # clauses that may pair: most satisfied states
+        H = self.holds(order)
+        Hp, Hn = H[:, pos].astype(np.int32), H[:, neg].astype(np.int32)
+        tp2, fp2 = Hp @ Hp.T, Hn @ Hn.T
         iu = np.triu_indices(len(order), 1)
-        tp = np.concatenate([Hp.sum(1), tp2[iu]]).astype(float)
-        fp = np.concatenate([Hn.sum(1), fp2[iu]]).astype(float)
+        tp = np.concatenate([self.tp, tp2[iu]]).astype(float)
+        fp = np.concatenate([self.fp, fp2[iu]]).astype(float)
         bits = np.concatenate([bits1, bits1[order][iu[0]] + bits1[order][iu[1]]])
         index = [(int(i),) for i in range(self.n)] + list(zip(order[iu[0]].tolist(), order[iu[1]].tolist(), strict=True))
         agreement = 0.5 * (tp / n_pos + (n_neg - fp) / n_neg)

@@ -119,6 +119,11 @@ class Relation(Node):
         """The object the relation names (it must be in the scene; a named block is not in the group)."""
         return None
 
+    def same_ok(self, p: str) -> tuple[str, str]:
+        """The relation and parameter whose ``ok`` this one's is (itself, unless it wraps another):
+        a judge computes each such verdict once per state."""
+        return self.key, p
+
     def possible(self, b: str, objects: tuple[str, ...], p: str) -> bool:
         """Static check: can ``b`` be made to satisfy the relation in a scene of ``objects``?"""
         r = self.refers(p)

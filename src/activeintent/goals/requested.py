@@ -235,6 +235,9 @@ class IfThere(Relation):
     def ok(self, f, b, p):
         return self.inner.ok(f, b, p)
 
+    def same_ok(self, p):
+        return self.inner.same_ok(p)
+
     def possible(self, b, objects, p):
         return self.refers(p) not in objects or self.inner.possible(b, objects, p)
 

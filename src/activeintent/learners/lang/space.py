@@ -94,6 +94,11 @@ class Compiled:
         self._rel_if = [NODES["relation"][r].refers(p) if NODES["relation"][r].vacuous_without_ref else None
                         for r, p in self.rels]
         self._has_if = any(r is not None for r in self._rel_if)
+        # per relation row: its node, parameter and named object, and the earlier row with the
+        # same verdicts (an "if there" relation's are its inner relation's), or its own index
+        self._rel_rows = [(NODES["relation"][r], p, NODES["relation"][r].refers(p)) for r, p in self.rels]
+        first: dict[tuple[str, str], int] = {}
+        self._rel_copy = [first.setdefault(node.same_ok(p), j) for j, (node, p, _) in enumerate(self._rel_rows)]
         self.f_sel = [sels[(clauses[i].sel, clauses[i].sp)] for i in self.forms]
         shapes: dict[tuple[str, str], int] = {}
         for i in self.forms:
@@ -142,16 +147,18 @@ class Compiled:
             self._selected.put((blocks, bowls), S)
         R = np.zeros((len(self.rels), len(blocks)), bool)
         X = np.zeros_like(R)
-        for j, (r, p) in enumerate(self.rels):
-            node = NODES["relation"][r]
-            ref = node.refers(p)
-            if ref is not None and ref not in objects:
+        for j, (node, p, ref) in enumerate(self._rel_rows):
+            if (src := self._rel_copy[j]) != j:
+                R[j], X[j] = R[src], X[src]
                 continue
-            for k, b in enumerate(blocks):
-                if b == ref:
-                    X[j, k] = True
-                elif node.ok(f, b, p):  # type: ignore[attr-defined]
-                    R[j, k] = True
+            if ref is None:
+                R[j] = [node.ok(f, b, p) for b in blocks]
+            elif ref in objects:
+                for k, b in enumerate(blocks):
+                    if b == ref:
+                        X[j, k] = True
+                    elif node.ok(f, b, p):
+                        R[j, k] = True
         Si = S.astype(np.int32)
         C = Si @ R.T.astype(np.int32)
         size = Si.sum(1)[:, None] - Si @ X.T.astype(np.int32)
