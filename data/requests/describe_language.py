@@ -56,6 +56,21 @@ nearest the middle of the table (central), whichever bowls are there that day. A
 ending in "-if-there" makes its clause hold on a day the object it names is not on the table
 (whatever the quantifier); without "-if-there", a clause about an absent object cannot hold."""
 
+PLACES = """## Sizes and places (what each place accepts)
+
+The table is 60 × 60 cm; blocks are 4 cm cubes; a bowl is 13 cm across. Split the table into a
+3 × 3 grid of 20 cm squares: the *back strip* / *front strip* is the back / front row of the grid
+(the third of the table farthest from / nearest the person); the *back half* / *front half* and
+*left half* / *right half* are halves (30 cm); the *centre* is the grid's middle square; a *corner*
+is a corner square of the grid. "Along an edge" (`@back-edge` …, `table-part:an-edge`) is
+within 10 cm of that edge. Two objects are *next to* each other when their outlines are less
+than 5 cm apart. `side:right/X` ("right of X") holds anywhere to the right of X's outline, at
+any distance and any depth — for "right beside X" add `next-to:X`. A place clause (`region`,
+`table-part`) holds only for a block standing on the table itself: a block in a bowl or on
+another block is in no region; to place a tower or stack, use the structure's `@place`
+parameter, which looks at the tower's bottom block. Rows and columns are of blocks standing on
+the table in a straight line, each less than 5 cm from its neighbour (touching or nearly)."""
+
 
 def known(key: str) -> str | None:
     """What is wrong with ``key`` in the language in force, or None."""
@@ -81,7 +96,7 @@ def known(key: str) -> str | None:
     return None
 
 
-def describe() -> str:
+def describe(places: bool = False) -> str:
     from activeintent.goals.language import QUANTS, nodes, parse_goal, spoken
 
     out = ["# The goal language (what a translator is given)", "",
@@ -107,6 +122,8 @@ def describe() -> str:
             out.append(f"- `{key}` — {g.sentence()}  ({g.bits:.1f} bits)")
     pairs = ", colours:X+Y / all-but-colours:X+Y" if spoken() >= 2 else ""
     out += ["", NOTES.format(pairs) + (NOTES_2 if spoken() >= 2 else ""), ""]
+    if places:
+        out += [PLACES, ""]
     return "\n".join(out)
 
 
@@ -114,12 +131,13 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--language", type=int, default=None, help="language version (default: the latest)")
     ap.add_argument("--check", nargs="+", metavar="KEY", help="print each key's sentence and bits, or what is wrong")
+    ap.add_argument("--places", action="store_true", help="add the sizes and extents of the places (pass 3 on)")
     args = ap.parse_args()
     from activeintent.goals.language import LATEST, parse_goal, speaking
 
     with speaking(args.language or LATEST):
         if not args.check:
-            sys.stdout.write(describe())
+            sys.stdout.write(describe(args.places))
             return
         for key in args.check:
             wrong = known(key)
