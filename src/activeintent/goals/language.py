@@ -1272,6 +1272,15 @@ class SameCorner(Structure):
         return c.get(fa.cell[b], 0) >= max(c.values())
 
 
+def bowl_counts(f: Facts, g: Group) -> dict[str, int]:
+    """How many blocks of the group each bowl of the state holds (0 for an empty bowl)."""
+    c = dict.fromkeys(f.bowls, 0)
+    for b in g:
+        if (w := f.bowl_of[b]) is not None:
+            c[w] += 1
+    return c
+
+
 class EachBowl(Structure):
     """Every bowl of the scene holds exactly ``n`` blocks of the group (the rest stay out)."""
 
@@ -1283,11 +1292,7 @@ class EachBowl(Structure):
         return f"every bowl holds exactly {NUMBER[p]} of {subject}"
 
     def _counts(self, f, g):
-        c = dict.fromkeys(f.bowls, 0)
-        for b in g:
-            if (w := f.bowl_of[b]) is not None:
-                c[w] += 1
-        return c
+        return bowl_counts(f, g)
 
     def holds(self, f, g, p):
         return bool(f.bowls) and all(n == int(p) for n in self._counts(f, g).values())

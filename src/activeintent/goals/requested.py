@@ -44,6 +44,7 @@ from activeintent.goals.language import (
     Tower,
     _near_first,
     _towers,
+    bowl_counts,
     free_points,
     in_region,
     region_points,
@@ -509,6 +510,7 @@ class ByEachBowl(Structure):
         return [PutNextTo(block=b, target=w, side=side) for w, n in c.items() if n == 0 for b in free]
 
 
+CAPS = {"max-2": 2, "max-3": 3}  # blocks a bowl may hold under a cap
 LOADS = {"max-2": "no bowl holds more than two of them", "max-3": "no bowl holds more than three of them",
          "even": "they are all in bowls, spread evenly (no bowl holds two more than another)"}
 
@@ -525,32 +527,27 @@ class BowlLoad(Structure):
         return f"{LOADS[p].replace('them', subject, 1).replace('they are', subject + ' are', 1)}"
 
     def _counts(self, f: Facts, g: Group) -> dict[str, int]:
-        c = dict.fromkeys(f.bowls, 0)
-        for b in g:
-            if (w := f.bowl_of[b]) is not None:
-                c[w] += 1
-        return c
+        return bowl_counts(f, g)
 
     def holds(self, f, g, p):
         c = self._counts(f, g)
         if p == "even":
             return bool(c) and all(f.bowl_of[b] is not None for b in g) and max(c.values()) - min(c.values()) <= 1
-        return all(n <= (2 if p == "max-2" else 3) for n in c.values())
+        return all(n <= CAPS[p] for n in c.values())
 
     def score(self, f, g, p):
         c = self._counts(f, g)
         if p == "even":
             inside = sum(c.values()) / len(g)
             return inside if not c or max(c.values()) - min(c.values()) <= 1 else inside / 2
-        cap = 2 if p == "max-2" else 3
-        return 1.0 - sum(max(n - cap, 0) for n in c.values()) / len(g)
+        return 1.0 - sum(max(n - CAPS[p], 0) for n in c.values()) / len(g)
 
     def moved_ok(self, fb, fa, g, b, p):
         w = fa.bowl_of[b]
         if p == "even":
             c = self._counts(fa, g)
             return w is not None and c[w] - 1 <= min(c.values())
-        return w is None or self._counts(fa, g)[w] <= (2 if p == "max-2" else 3)
+        return w is None or self._counts(fa, g)[w] <= CAPS[p]
 
     def possible(self, g, objects, p):
         return p != "even" or any(kind_of(o) == "bowl" for o in objects)
