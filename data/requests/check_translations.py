@@ -4,7 +4,10 @@
     .venv/bin/python data/requests/check_translations.py --writers [--scenes 100]
 
 Pass 1: translations.jsonl (language 1), check_sample.json → check_results.json; pass 2:
-translations-2.jsonl (language 2), check_sample_2.json → check_results_2.json.
+translations-2.jsonl (language 2), check_sample_2.json → check_results_2.json; pass 3:
+translations-3.jsonl (language 2 again, the brief's second lesson), check_sample_3.json (an order
+drawn before pass 3 was read: its first 40 translated and first 20 marked requests) →
+check_results_3.json.
 For the 40 translated requests of the sample: the translator's goal against the checker a
 second writer wrote from the request alone (checkers/*.py, class R<id>), both ways on test
 scenes where the checker is feasible (`coverage --goal`); they agree when both shares are
@@ -39,7 +42,18 @@ def _checker(rid: str, folder: Path = HERE / "checkers"):
 
 
 PASSES = {1: ("translations.jsonl", "check_sample.json", "check_results.json"),
-          2: ("translations-2.jsonl", "check_sample_2.json", "check_results_2.json")}
+          2: ("translations-2.jsonl", "check_sample_2.json", "check_results_2.json"),
+          3: ("translations-3.jsonl", "check_sample_3.json", "check_results_3.json")}
+LANGUAGE = {1: 1, 2: 2, 3: 2}  # the language each pass translated into
+
+
+def drawn(sample: dict, rows: dict[str, dict]) -> dict[str, list[str]]:
+    """The sample's translated and "not expressible" requests: listed, or the first 40 / 20 of
+    its drawn order."""
+    if "order" not in sample:
+        return sample
+    return {"translated": [i for i in sample["order"] if rows[i]["expressible"]][:40],
+            "not_expressible": [i for i in sample["order"] if not rows[i]["expressible"]][:20]}
 
 
 def _translated(args: tuple[str, str, int, int]) -> dict:
@@ -110,7 +124,7 @@ def writers(scenes: int, jobs: int) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--pass", dest="which", type=int, choices=sorted(PASSES), default=max(PASSES),
-                    help="which translation pass (its language is the pass's number)")
+                    help="which translation pass")
     ap.add_argument("--translated-only", action="store_true",
                     help="score the translations only (the marks' coverage search is the long part)")
     ap.add_argument("--writers", action="store_true",
@@ -121,15 +135,17 @@ def main() -> None:
     if args.writers:
         return writers(args.scenes, args.jobs)
     translations, sample_file, results = PASSES[args.which]
-    sample = json.loads((HERE / sample_file).read_text())
-    goals = {r["id"]: r["goal"] for r in map(json.loads, (HERE / translations).read_text().splitlines())}
+    language = LANGUAGE[args.which]
+    rows = {r["id"]: r for r in map(json.loads, (HERE / translations).read_text().splitlines())}
+    goals = {i: r["goal"] for i, r in rows.items()}
+    sample = drawn(json.loads((HERE / sample_file).read_text()), rows)
     with multiprocessing.get_context("spawn").Pool(args.jobs) as pool:
-        translated = pool.map(_translated, [(i, goals[i], args.scenes, args.which) for i in sample["translated"]])
+        translated = pool.map(_translated, [(i, goals[i], args.scenes, language) for i in sample["translated"]])
         marked = [] if args.translated_only else pool.map(
-            _not_expressible, [(i, args.scenes, args.which) for i in sample["not_expressible"]])
+            _not_expressible, [(i, args.scenes, language) for i in sample["not_expressible"]])
     agree = sum(r["agree"] for r in translated)
     confirmed = sum(r["confirmed"] for r in marked)
-    out = {"pass": args.which, "language": args.which, "agree": agree, "translated": len(translated),
+    out = {"pass": args.which, "language": language, "agree": agree, "translated": len(translated),
            "confirmed": confirmed, "not_expressible": len(marked),
            "threshold": AGREE, "scenes": args.scenes, "translated_rows": translated, "not_expressible_rows": marked}
     (HERE / results).write_text(json.dumps(out, indent=1) + "\n")
