@@ -176,3 +176,22 @@ def test_the_search_keeps_each_states_verdicts_and_counts_exactly():
     assert H.shape[1] == len(search.labels) and (search.y == y).all()
     assert (search.holds(rows) == H).all()
     assert (search.tp == H[:, y].sum(1)).all() and (search.fp == H[:, ~y].sum(1)).all()
+
+
+def test_coverage_reports_bits_and_rank_under_the_prior_asked_for():
+    from activeintent.goals.language import speaking
+    from activeintent.goals.prior import goal_bits, load_prior
+
+    with speaking(1):  # language 1: a small space to build
+        fitted = load_prior("fitted")
+        got = cov.coverage(GoalIntention(parse_goal("every all: in-bowl:same")), scenes=8, test_scenes=10, prior=fitted)
+        z = parse_goal(got.goal)
+        assert got.bits == round(goal_bits(z, fitted), 2) != round(z.bits, 2)
+        assert got.prior_rank == cov.prior_rank(goal_bits(z, fitted), cov.start_space_info(fitted)["distinct_bits"])
+
+
+def test_coverage_refuses_a_prior_without_bits():
+    from activeintent.cli import app
+
+    out = CliRunner().invoke(app, ["coverage", "--intentions", "stack", "--prior", "uniform"])
+    assert out.exit_code == 2 and "--prior uniform" in out.output

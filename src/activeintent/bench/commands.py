@@ -244,6 +244,8 @@ def coverage(
     goal: Annotated[str | None, typer.Option("--goal", help="Score this goal of the language against each intention "
                                              "both ways (its plan satisfies the intention; the intention's plan "
                                              "satisfies it) instead of searching for the best goal")] = None,
+    prior: Annotated[str, typer.Option("--prior", help="Whose bits L(z*) and prior rank: length (description length) | "
+                                       "fitted (fitted to data/requests) | file:PATH (written by `prior fit`)")] = "length",
 ) -> None:
     """How well the goal language can say each intention: its best goal by behaviour (the goal
     whose own plan satisfies the intention on most test scenes), that plan's success — the
@@ -270,6 +272,11 @@ def coverage(
         items = [resolve(n) for n in names] + [resolve(None, f) for f in intention_file or []]
         if not items:
             raise ValueError("nothing to measure: give --suite, --intentions or --intention-file")
+        if prior == "uniform":
+            raise ValueError("--prior uniform gives no bits to report: take length, fitted or file:PATH")
+        from activeintent.goals.prior import load_prior
+
+        load_prior(prior)  # a missing or malformed file is refused before the search
     except (ValueError, FileNotFoundError) as err:
         console.print(f"[red]error:[/red] {err}")
         raise typer.Exit(2) from None
@@ -296,7 +303,8 @@ def coverage(
                           f"feasible test scenes", highlight=False)
         return
     table = coverage_table(items, groups, seed=seed, scenes=scenes, test_scenes=test_scenes,
-                           progress=lambda text: print_line(console, escape(text)) if not as_json else None)
+                           progress=lambda text: print_line(console, escape(text)) if not as_json else None,
+                           prior=prior)
     if not after_freeze:  # per-intention rows of a held-out suite are the reading its rule forbids
         table["intentions"] = [r for r in table["intentions"] if not is_held_out(r["suite"])]
     if out is not None:

@@ -39,6 +39,7 @@ import numpy as np
 from activeintent.goals.facts import facts
 from activeintent.goals.language import Goal, all_clauses, parse_goal, spoken
 from activeintent.goals.planner import generic_moves, plan
+from activeintent.goals.prior import FittedPrior, goal_bits
 from activeintent.intentions.base import Intention
 from activeintent.learners.lang.space import Compiled
 from activeintent.protocol import sample_test_scene, stable_seed
@@ -250,8 +251,11 @@ def prior_rank(bits: float, distinct_bits) -> int:
 
 def coverage(intention: Intention, seed: int = 0, scenes: int = SELECTION_SCENES, test_scenes: int = TEST_SCENES,
              top: int = TOP, rounds: int = ROUNDS, start_keys: set[str] | None = None,
-             distinct_bits=None, progress: Callable[[str], None] | None = None) -> Coverage:
-    """The best goal of the language for ``intention`` and its plan success (the oracle)."""
+             distinct_bits=None, progress: Callable[[str], None] | None = None,
+             prior: FittedPrior | None = None) -> Coverage:
+    """The best goal of the language for ``intention`` and its plan success (the oracle).
+    ``prior``: whose bits L(z*) and prior rank are reported, and which of equally good goals
+    is z* (the fewest bits); None: description length."""
     rng = np.random.default_rng(stable_seed("coverage-bank", seed, intention.name))
     chosen = feasible_scenes(intention, scenes, seed, "selection")
     trials = _bank(intention, chosen, rng)
@@ -272,29 +276,37 @@ def coverage(intention: Intention, seed: int = 0, scenes: int = SELECTION_SCENES
         if progress:
             best = max(tried, key=lambda k: (tried[k], -goals[k].bits))
             progress(f"{intention.name}: round {r + 1}/{rounds}, {len(tried)} goals planned, best {tried[best]:.2f}")
-    order = sorted(tried, key=lambda k: (-tried[k], goals[k].bits, k))
+    bits = {k: goal_bits(g, prior) for k, g in goals.items()}
+    order = sorted(tried, key=lambda k: (-tried[k], bits[k], k))
     z = goals[order[0]]
     held = feasible_scenes(intention, test_scenes, seed, "test")
     success, _ = goal_success(z, held, intention)
     if distinct_bits is None:
-        distinct_bits = start_space_info()["distinct_bits"]
+        distinct_bits = start_space_info(prior)["distinct_bits"]
     return Coverage(
         intention=intention.name, description=intention.description, goal=z.key, sentence=z.sentence(),
-        bits=round(z.bits, 2), prior_rank=prior_rank(z.bits, distinct_bits),
+        bits=round(bits[z.key], 2), prior_rank=prior_rank(bits[z.key], distinct_bits),
         in_start_space=bool(start_keys is not None and z.key in start_keys),
         selection_success=round(tried[z.key], 3), success=round(success, 3), test_scenes=len(held),
         planned_goals=len(tried),
-        runner_up=[{"goal": k, "selection_success": round(tried[k], 3), "bits": round(goals[k].bits, 2)}
+        runner_up=[{"goal": k, "selection_success": round(tried[k], 3), "bits": round(bits[k], 2)}
                    for k in order[1:4]])
 
 
 def coverage_table(intentions: list[Intention], suites: list[str], seed: int = 0, scenes: int = SELECTION_SCENES,
-                   test_scenes: int = TEST_SCENES, progress: Callable[[str], None] | None = None) -> dict:
-    """Coverage of every intention (rows carry their suite) and the means per suite."""
-    keys = start_space_keys()
+                   test_scenes: int = TEST_SCENES, progress: Callable[[str], None] | None = None,
+                   prior: str = "length") -> dict:
+    """Coverage of every intention (rows carry their suite) and the means per suite; bits and
+    prior ranks under ``prior`` (length, fitted or file:PATH)."""
+    from activeintent.goals.prior import load_prior
+
+    fitted = load_prior(prior)
+    info = start_space_info(fitted)
+    keys, distinct = set(info["keys"]), info["distinct_bits"]
     rows = []
     for k, (it, group) in enumerate(zip(intentions, suites, strict=True), 1):
-        c = coverage(it, seed=seed, scenes=scenes, test_scenes=test_scenes, start_keys=keys)
+        c = coverage(it, seed=seed, scenes=scenes, test_scenes=test_scenes, start_keys=keys,
+                     distinct_bits=distinct, prior=fitted)
         rows.append({"suite": group, **c.row()})
         if progress:
             progress(f"{k}/{len(intentions)} {group}: {'(held out)' if is_held_out(group) else it.name} done")
@@ -309,7 +321,7 @@ def coverage_table(intentions: list[Intention], suites: list[str], seed: int = 0
                     "expressible": int((rates >= EXPRESSIBLE).sum()),
                     "median_bits": round(float(np.median([r["bits"] for r in got])), 2),
                     "in_start_space": int(sum(r["in_start_space"] for r in got))})
-    return {"protocol": {"language": spoken(), "seed": seed, "selection_scenes": scenes, "test_scenes": test_scenes,
+    return {"protocol": {"language": spoken(), "prior": prior, "seed": seed, "selection_scenes": scenes, "test_scenes": test_scenes,
                          "scenes": "the protocol's test-scene distribution, kept when the intention is feasible",
                          "plan": "the language's planner, variant 0, executed on the symbolic world model",
                          "search": "one- and two-clause goals, with and without 'stays'",
@@ -363,11 +375,12 @@ def oracle_of(intentions: dict[str, Intention], progress: Callable[[str], None] 
     return out
 
 
-def start_space_info() -> dict:
+def start_space_info(prior: FittedPrior | None = None) -> dict:
+    """The lang learners' starting space under ``prior`` (None: description length)."""
     from activeintent.learners.lang.learner import KEEP
     from activeintent.learners.lang.space import space_info
 
-    return space_info(0, KEEP)
+    return space_info(0, KEEP, prior=prior)
 
 
 def start_space_keys() -> set[str]:
