@@ -22,7 +22,7 @@ FAST = {"paper"}  # every method re-run in the fast suite; every other headline 
 # The method re-run from each headline folder in CI (one episode: the sample covers every product
 # learner across the folders); `bench-verify --all` re-runs one episode of every method of every
 # folder, experiments' included, before a release.
-CI_METHOD = {"dev": "lang-stop", "heldout-freeze": "lang-preference", "peer": "reward-stop",
+CI_METHOD = {"dev": "lang-stop", "dev-lang2": "lang-stop", "heldout-freeze": "lang-preference", "peer": "reward-stop",
              "truth-goals-stop": "lang-stop", "truth-goals-preference": "lang-preference",
              "truth-goals-exact": "zero-signal", "library": "bayes-preference", "heldout": "bayes-stop",
              "eig-vs-random": "random-query-preference", "paper-physics": "bayes-stop"}
