@@ -176,6 +176,8 @@ def test_the_search_keeps_each_states_verdicts_and_counts_exactly():
     assert H.shape[1] == len(search.labels) and (search.y == y).all()
     assert (search.holds(rows) == H).all()
     assert (search.tp == H[:, y].sum(1)).all() and (search.fp == H[:, ~y].sum(1)).all()
+    kept = search.comp._tag + ("c",)  # a state's memo keeps none of the search's verdicts (MBs each)
+    assert not any(kept in facts(s).memo for t in trials for s in t.states)
 
 
 def test_coverage_reports_bits_and_rank_under_the_prior_asked_for():

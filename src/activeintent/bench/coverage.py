@@ -197,7 +197,10 @@ class Search:
             if key in self.seen:
                 continue
             self.seen.add(key)
-            col = self.comp.clause_eval(facts(s))[0][: self.n] & self.P[:, k]
+            f = facts(s)
+            col = self.comp.clause_eval(f)[0][: self.n] & self.P[:, k]
+            # the state's memo would keep MBs of verdicts per state (as in build_space): dropped once read
+            f.memo.pop(self.comp._tag + ("c",), None)
             label = bool(self.intention.satisfied(s))
             (self.tp if label else self.fp)[col] += 1
             self.columns.append(np.packbits(col))
