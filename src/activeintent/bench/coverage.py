@@ -39,7 +39,7 @@ import numpy as np
 from activeintent.goals.facts import facts
 from activeintent.goals.language import Goal, all_clauses, parse_goal, spoken
 from activeintent.goals.planner import generic_moves, plan
-from activeintent.goals.prior import FittedPrior, goal_bits
+from activeintent.goals.prior import FittedPrior, goal_bits, load_prior
 from activeintent.intentions.base import Intention
 from activeintent.learners.lang.space import Compiled
 from activeintent.protocol import sample_test_scene, stable_seed
@@ -301,8 +301,6 @@ def coverage_table(intentions: list[Intention], suites: list[str], seed: int = 0
                    prior: str = "length") -> dict:
     """Coverage of every intention (rows carry their suite) and the means per suite; bits and
     prior ranks under ``prior`` (length, fitted or file:PATH)."""
-    from activeintent.goals.prior import load_prior
-
     fitted = load_prior(prior)
     info = start_space_info(fitted)
     keys, distinct = set(info["keys"]), info["distinct_bits"]
