@@ -27,7 +27,7 @@ Env = Annotated[str, typer.Option("--env", help="Where plans run: pybullet | sym
 User = Annotated[str, typer.Option("--user", help="Simulated-user preset: human | paper | exact (see docs/protocol.md)")]
 NewScene = Annotated[str, typer.Option("--new-scene", help="counted (every answer is a signal) | free (old rule, ≤3 uncounted) | off")]
 Prior = Annotated[str | None, typer.Option("--prior", help="Bayesian prior: length (description length) | uniform | fitted (lang-*: fitted to data/requests) | file:PATH (lang-*: written by `prior fit`); default: the method's own (lang-*: fitted, the others: length)")]
-Scenes = Annotated[str, typer.Option("--scenes", help="bayes-* and lang-*: scenes to ask in: sampled | belief (those the belief expects to show its goals)")]
+Scenes = Annotated[str, typer.Option("--scenes", help="bayes-* and lang-*: scenes to ask in: sampled | belief (those the belief expects to show its goals) | a plug-in's (SCENE_DESIGNS)")]
 Llm = Annotated[str, typer.Option("--llm", help="LLM: embedded | gguf:/path.gguf | openai:<model> | none (Bayesian methods and baselines)")]
 Vlm = Annotated[str | None, typer.Option("--vlm", help="Multimodal model spec for the retriever (default: the LLM)")]
 BaseUrl = Annotated[str | None, typer.Option("--base-url", envvar="OPENAI_BASE_URL", help="OpenAI-compatible endpoint")]

@@ -92,6 +92,7 @@ def check_spec(spec: RunSpec) -> RunSpec:
     Returns the spec that will run (the method's defaults filled in: :func:`with_method_defaults`)."""
     from activeintent.act.executors import EXECUTORS
     from activeintent.envs import ENVS
+    from activeintent.learners.bayes.scenes import SCENE_DESIGNS
     from activeintent.learners.registry import get_method
     from activeintent.llm.registry import parse_spec
     from activeintent.registry import load_plugin
@@ -109,6 +110,7 @@ def check_spec(spec: RunSpec) -> RunSpec:
                              f"{spec.learner.method} takes length or uniform (lang-* take fitted and file:PATH)")
         load_prior(spec.learner.prior, spec.learner.language)  # a missing, malformed or other-language file is refused before any work
     ENVS.check(spec.env.name)
+    SCENE_DESIGNS.check(spec.learner.scenes)
     USER_PRESETS.check(spec.user.preset)
     if method.needs_llm and spec.models.llm == "none":
         raise ValueError(f"--method {spec.learner.method} needs a language model; --llm none is only for methods "

@@ -101,8 +101,8 @@ class LearnerConfig(BaseModel):
     prior: str | None = Field(None, pattern="^(length|uniform|fitted|file:.+)$",
                               description="length | uniform | fitted (lang-* only) | file:PATH (lang-*, from `prior fit`) | "
                               "None: the method's own (lang-*: fitted, the others: length)")
-    scenes: str = Field("sampled", pattern="^(sampled|belief)$",
-                        description="bayes-* and lang-*: sampled scenes, or scenes the belief expects to show z")
+    scenes: str = Field("sampled", description="bayes-* and lang-*: how query scenes are chosen, a name of "
+                        "SCENE_DESIGNS (sampled | belief | a plug-in's)")
     language: int = Field(LATEST, description="lang-*: the goal language's version (recorded, so that an episode "
                           "run before the language grew replays in its own)")
     epsilon: float = Field(2.0, ge=0, description="ε: seconds before the stop for image I_b")

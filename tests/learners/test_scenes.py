@@ -14,7 +14,7 @@ from activeintent.learners.bayes.scenes import SCENE_DESIGNS
 from activeintent.learners.lang.hypotheses import LangSpace
 from activeintent.learners.lang.learner import LangConfig, LangLearner
 from activeintent.learners.registry import LearnerContext, get_method
-from activeintent.runner import build_episode
+from activeintent.runner import build_episode, check_spec
 from activeintent.spec import LearnerConfig, RunSpec
 
 RED_ON_BLUE = "every colour:red on-the-block:blue"
@@ -55,5 +55,7 @@ def test_the_spec_records_which_design_ran(tmp_path):
     build_episode(spec, tmp_path).run()
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["config"]["options"]["scenes"] == "belief"
-    with pytest.raises(ValueError, match="--scenes"):
-        RunSpec.from_options(scenes="clever")
+    with pytest.raises(ValueError, match="Unknown scene design 'clever'; valid scene designs: sampled, belief"):
+        check_spec(RunSpec.from_options(scenes="clever"))
+    with pytest.raises(ValueError, match="Unknown scene design"):
+        LangConfig(scenes="clever")

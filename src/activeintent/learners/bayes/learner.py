@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, Field, field_validator
 
 from activeintent import ranking
 from activeintent.goals.facts import facts
@@ -30,7 +30,7 @@ from activeintent.learners.bayes.belief import Belief, Prior
 from activeintent.learners.bayes.candidates import candidate_plans, predict
 from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space
 from activeintent.learners.bayes.judge import HypothesisJudge
-from activeintent.learners.bayes.scenes import SCENE_DESIGNS, SceneDesign
+from activeintent.learners.bayes.scenes import SCENE_DESIGNS
 from activeintent.llm.base import ChatModel, ModelError
 from activeintent.signals import Answer, Signal, get_signal
 from activeintent.world import (
@@ -56,8 +56,8 @@ class BayesConfig(BaseModel):
     prior: Prior = Field("length", description="length: P(z) ∝ 2^-L(z); uniform: the ablation")
     choose: str = Field("eig", description="eig: largest expected information gain; random: the baseline")
     n_scenes: int = Field(4, ge=1, description="candidate scenes scored per design_scene")
-    scenes: SceneDesign = Field(
-        "sampled", description="how the candidate scenes are chosen (scenes.py): sampled: n_scenes random "
+    scenes: str = Field(
+        "sampled", description="how the candidate scenes are chosen (scenes.py, SCENE_DESIGNS): sampled: n_scenes random "
         "scenes; belief: the n_scenes of scene_candidates random ones that the belief most expects to show "
         "its goals, also after a 'new scene' answer")
     scene_candidates: int = Field(16, ge=1, description="scenes drawn per design_scene when scenes = belief")
@@ -71,6 +71,11 @@ class BayesConfig(BaseModel):
     proposal_mass: float = Field(0.05, gt=0, lt=1, description="prior mass given to model-proposed hypotheses")
     max_proposal_calls: int = Field(3, ge=0, description="model calls for new hypotheses per episode")
     hypothesis_seed: int = Field(0, description="seed of the bank that deduplicates H")
+
+    @field_validator("scenes")
+    @classmethod
+    def _known_design(cls, name: str) -> str:
+        return SCENE_DESIGNS.check(name)
 
 
 @dataclass

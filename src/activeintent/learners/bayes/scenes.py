@@ -2,27 +2,26 @@
 
 A design is chosen by name (``--scenes``): ``sampled`` draws random scenes, ``belief`` draws
 scenes that the belief expects to be able to show its likely z (a scene that cannot show z
-costs an answer, "new scene", that tells little). Register your own in ``SCENE_DESIGNS``.
+costs an answer, "new scene", that tells little). Register your own in ``SCENE_DESIGNS``
+(``SCENE_DESIGNS.register("name", Design(...))`` in a ``--plugin`` file).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from activeintent import ranking
 from activeintent.learners.bayes.acquisition import particles
 from activeintent.learners.bayes.hypotheses import random_scene
+from activeintent.registry import Registry
 from activeintent.world import Scene
 
 if TYPE_CHECKING:  # the learner calls the design, not the other way round
     from activeintent.learners.bayes.learner import BayesLearner
-
-SceneDesign = Literal["sampled", "belief"]
-
 
 @dataclass(frozen=True)
 class Design:
@@ -67,7 +66,8 @@ def belief_scenes(learner: BayesLearner) -> Iterator[Scene]:
     yield from (drawn[i] for i in sorted(keep))
 
 
-SCENE_DESIGNS: dict[str, Design] = {
-    "sampled": Design(sampled_scenes, False, "random scenes; the protocol samples after 'new scene'"),
-    "belief": Design(belief_scenes, True, "scenes the belief expects to show its likely z, also after 'new scene'"),
-}
+SCENE_DESIGNS: Registry[Design] = Registry("scene design")
+SCENE_DESIGNS.register("sampled", Design(sampled_scenes, False, "random scenes; the protocol samples after 'new scene'"),
+                       help="random scenes")
+SCENE_DESIGNS.register("belief", Design(belief_scenes, True, "scenes the belief expects to show its likely z, also after 'new scene'"),
+                       help="scenes the belief expects to show its likely z")

@@ -1,0 +1,54 @@
+"""Scene designs that ask again on tables the person has answered about.
+
+    bin/activeintent bench --plugin experiments/answered-scenes/answered.py --scenes answered ...
+
+A "new scene" answer says the person cannot show their intention on that table; an answer about
+the trajectories says they can. The belief's own guess of which tables can show z (``belief``)
+is only as good as the belief, so these designs lean on what the person's answers showed:
+
+- ``answered``: once some table got an answer about its trajectories, the candidates are those
+  tables' objects laid out anew (the most recent first, ``n_scenes`` at most); before that, the
+  ``belief`` design's candidates.
+- ``answered-mixed``: the answered tables laid out anew *and* the ``belief`` design's candidates;
+  EIG chooses among all of them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+from activeintent.learners.bayes.scenes import SCENE_DESIGNS, Design, belief_scenes, sampled_scenes
+from activeintent.world import Scene
+
+
+def answered_tables(learner) -> list[tuple[str, ...]]:
+    """The object sets of the tables answered about (not "new scene"), most recent first."""
+    seen = [tuple(o.scene.objects) for o in reversed(learner.observations) if not o.answer.new_scene]
+    return list(dict.fromkeys(seen))
+
+
+def answered_scenes(learner) -> Iterator[Scene]:
+    if learner.config.choose == "random":
+        yield from sampled_scenes(learner)
+        return
+    tables = answered_tables(learner)[:learner.config.n_scenes]
+    if not tables:
+        yield from belief_scenes(learner)
+        return
+    for objects in tables:
+        yield Scene(objects=list(objects))
+
+
+def answered_mixed_scenes(learner) -> Iterator[Scene]:
+    if learner.config.choose == "random":
+        yield from sampled_scenes(learner)
+        return
+    for objects in answered_tables(learner)[:learner.config.n_scenes]:
+        yield Scene(objects=list(objects))
+    yield from belief_scenes(learner)
+
+
+SCENE_DESIGNS.register("answered", Design(answered_scenes, True, "tables already answered about, laid out anew"),
+                       help="tables the person answered about, laid out anew (belief's before any answer)")
+SCENE_DESIGNS.register("answered-mixed", Design(answered_mixed_scenes, True, "answered tables and the belief's"),
+                       help="answered tables laid out anew, and the belief's candidates")
