@@ -22,9 +22,13 @@ from activeintent.world import Scene
 
 
 def answered_tables(learner) -> list[tuple[str, ...]]:
-    """The object sets of the tables answered about (not "new scene"), most recent first."""
-    seen = [tuple(o.scene.objects) for o in reversed(learner.observations) if not o.answer.new_scene]
-    return list(dict.fromkeys(seen))
+    """The object sets of the tables whose latest answer was about the trajectories (not "new
+    scene": a person may miss that a table cannot show their intention once, and say so later),
+    most recent first."""
+    latest: dict[tuple[str, ...], bool] = {}
+    for o in reversed(learner.observations):
+        latest.setdefault(tuple(o.scene.objects), not o.answer.new_scene)
+    return [objects for objects, answered in latest.items() if answered]
 
 
 def answered_scenes(learner) -> Iterator[Scene]:
