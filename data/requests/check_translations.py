@@ -80,21 +80,14 @@ def _not_expressible(args: tuple[str, int, int]) -> dict:
 def _writers(args: tuple[str, str, int]) -> dict:
     """The first checker against the second (plans both ways, on scenes where both are feasible),
     and the translated goal against the second checker."""
-    from activeintent.bench.coverage import agreement, feasible_scenes, run_plan
+    from activeintent.bench.coverage import agreement, feasible_scenes, plan_satisfies
     from activeintent.goals.language import parse_goal, speaking
-    from activeintent.world import WorldState, layout
 
     rid, key, n = args
     first, second = _checker(rid), _checker(rid, HERE / "checkers" / "second")
     scenes = [(sc, seed) for sc, seed in feasible_scenes(first, 3 * n, 0, "agreement") if second.feasible(sc)][:n]
-    ways = {}
-    for name, a, b in (("first_plan_satisfies_second", first, second), ("second_plan_satisfies_first", second, first)):
-        hits = 0
-        for scene, seed in scenes:
-            s0 = WorldState(positions=layout(scene, seed))
-            steps = a.plan(s0)
-            hits += steps is not None and bool(b.satisfied(run_plan(s0, steps)))
-        ways[name] = round(hits / max(len(scenes), 1), 4)
+    ways = {name: round(plan_satisfies(a, b.satisfied, scenes), 4)
+            for name, a, b in (("first_plan_satisfies_second", first, second), ("second_plan_satisfies_first", second, first))}
     with speaking(2):
         goal = agreement(parse_goal(key), second, n)
     return {"id": rid, "scenes": len(scenes), **ways, "writers_agree": min(ways.values()) >= AGREE,

@@ -197,3 +197,16 @@ def test_coverage_refuses_a_prior_without_bits():
 
     out = CliRunner().invoke(app, ["coverage", "--intentions", "stack", "--prior", "uniform"])
     assert out.exit_code == 2 and "--prior uniform" in out.output
+
+
+def test_agreement_scores_a_given_goal_against_a_checker_both_ways():
+    """Every block in some bowl against "every block in the bowl of its colour": the checker's
+    plan satisfies the looser goal everywhere, the goal's own plan the checker only sometimes."""
+    looser = parse_goal("every all: in-bowl:any")
+    checker = GoalIntention(parse_goal("every all: in-bowl:same"))
+    got = cov.agreement(looser, checker, n=20)
+    assert got["scenes"] == 20
+    assert got["checker_plan_satisfies_goal"] == 1.0
+    assert got["goal_plan_satisfies_checker"] < 1.0
+    same = cov.agreement(parse_goal("every all: in-bowl:same"), checker, n=20)
+    assert same["checker_plan_satisfies_goal"] == same["goal_plan_satisfies_checker"] == 1.0

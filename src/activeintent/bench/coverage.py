@@ -128,13 +128,20 @@ def agreement(goal: Goal, intention: Intention, n: int = TEST_SCENES, seed: int 
     checker's own plan satisfies the goal (a goal or checker with no plan there fails)."""
     scenes = feasible_scenes(intention, n, seed, "agreement")
     forward, _ = goal_success(goal, scenes, intention)
+    backward = plan_satisfies(intention, lambda state: goal.holds(facts(state)), scenes)
+    return {"goal": goal.key, "intention": intention.name, "scenes": len(scenes),
+            "goal_plan_satisfies_checker": round(forward, 4), "checker_plan_satisfies_goal": round(backward, 4)}
+
+
+def plan_satisfies(planner: Intention, satisfied: Callable[[WorldState], bool], scenes: list[tuple[Scene, int]]) -> float:
+    """The share of ``scenes`` (laid out by their seeds) where ``planner``'s own plan, executed,
+    ends in a state that ``satisfied`` accepts (no plan: a miss)."""
     hits = 0
     for scene, layout_seed in scenes:
         s0 = WorldState(positions=layout(scene, layout_seed))
-        steps = intention.plan(s0)
-        hits += steps is not None and goal.holds(facts(run_plan(s0, steps)))
-    return {"goal": goal.key, "intention": intention.name, "scenes": len(scenes),
-            "goal_plan_satisfies_checker": round(forward, 4), "checker_plan_satisfies_goal": round(hits / len(scenes), 4)}
+        steps = planner.plan(s0)
+        hits += steps is not None and bool(satisfied(run_plan(s0, steps)))
+    return hits / max(len(scenes), 1)
 
 
 def _bank(intention: Intention, scenes: list[tuple[Scene, int]], rng: np.random.Generator) -> list[Trial]:
