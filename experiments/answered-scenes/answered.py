@@ -6,11 +6,10 @@ A "new scene" answer says the person cannot show their intention on that table; 
 the trajectories says they can. The belief's own guess of which tables can show z (``belief``)
 is only as good as the belief, so these designs lean on what the person's answers showed:
 
-- ``answered``: once some table got an answer about its trajectories, the candidates are those
-  tables' objects laid out anew (the most recent first, ``n_scenes`` at most); before that, the
-  ``belief`` design's candidates.
-- ``answered-mixed``: the answered tables laid out anew *and* the ``belief`` design's candidates;
-  EIG chooses among all of them.
+``answered``: once some table got an answer about its trajectories, the candidates are those
+tables' objects laid out anew (the most recent first, ``n_scenes`` at most; a table whose latest
+answer was "new scene" is left out); before that, the ``belief`` design's candidates. EIG
+chooses among them as usual.
 """
 
 from __future__ import annotations
@@ -43,16 +42,5 @@ def answered_scenes(learner) -> Iterator[Scene]:
         yield Scene(objects=list(objects))
 
 
-def answered_mixed_scenes(learner) -> Iterator[Scene]:
-    if learner.config.choose == "random":
-        yield from sampled_scenes(learner)
-        return
-    for objects in answered_tables(learner)[:learner.config.n_scenes]:
-        yield Scene(objects=list(objects))
-    yield from belief_scenes(learner)
-
-
 SCENE_DESIGNS.register("answered", Design(answered_scenes, True, "tables already answered about, laid out anew"),
                        help="tables the person answered about, laid out anew (belief's before any answer)")
-SCENE_DESIGNS.register("answered-mixed", Design(answered_mixed_scenes, True, "answered tables and the belief's"),
-                       help="answered tables laid out anew, and the belief's candidates")

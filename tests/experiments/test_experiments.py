@@ -27,13 +27,14 @@ EPISODES = {
     "reward-variants/noplanner.py": ("reward-stop-noplanner", "color-match", None),
     "grammar-intentions/grammar_intentions.py": ("bayes-stop", None, f"{GRAMMAR}:PINK_BOWL"),
 }
-SCRIPTS = {"decide/clairvoyant_bound.py", "defaults/compare.py"}  # run with their own command line, not methods
+SCRIPTS = {"decide/clairvoyant_bound.py", "defaults/compare.py", "answered-scenes/compare.py"}  # their own command line
+DESIGNS = {"answered-scenes/answered.py": "answered"}  # plug-in file → the scene design it registers
 HELPERS = {"decide/acquisition.py", "decide/decision.py", "decide/needs.py", "decide/plans.py"}  # loaded by the above
 
 
 def test_every_experiment_file_is_run_here():
     files = {str(p.relative_to(EXPERIMENTS)) for p in EXPERIMENTS.glob("*/*.py")}
-    assert files == set(EPISODES) | SCRIPTS | HELPERS
+    assert files == set(EPISODES) | SCRIPTS | HELPERS | set(DESIGNS)
     for folder in {p.parent for p in EXPERIMENTS.glob("*/*.py")}:
         assert (folder / "README.md").is_file(), f"{folder.name} has no README with its finding"
 
@@ -92,3 +93,36 @@ def test_the_defaults_comparison_pairs_arms_and_applies_the_rule(tmp_path):
     s = compare.summary(compare.arm_records(tmp_path))
     assert s["missing"] == ["fitted-sampled"] and s["default"] is None
     assert "No default chosen yet" in compare.markdown(s)
+
+
+@pytest.mark.parametrize("plugin", sorted(DESIGNS))
+def test_the_scene_design_runs_one_episode(plugin, tmp_path):
+    spec = RunSpec.from_options(method="lang-stop", intention="stack", plugins=[str(EXPERIMENTS / plugin)],
+                                scenes=DESIGNS[plugin], env="symbolic", llm="none", budget=3, test_scenes=3,
+                                test_pool=0, video="none", seed=1, language=1)
+    build_episode(spec, tmp_path).run()
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["config"]["options"]["scenes"] == DESIGNS[plugin] and summary["signals_used"] == 3
+
+
+def test_answered_scenes_ask_again_on_answered_tables_and_not_on_refused_ones():
+    from activeintent.goals.language import parse_goal
+    from activeintent.learners.bayes.learner import Observation
+    from activeintent.learners.lang.hypotheses import LangSpace
+    from activeintent.learners.lang.learner import LangConfig, LangLearner
+    from activeintent.signals.base import Answer
+    from activeintent.world import Scene
+
+    load_plugin(EXPERIMENTS / "answered-scenes" / "answered.py")
+    space = LangSpace([parse_goal(k) for k in ["every colour:red on-the-block:blue", "form tower:any all:"]])
+    learner = LangLearner("stop", rng=0, config=LangConfig(scenes="answered"), hypotheses=space.hypotheses)
+    assert learner.redesigns_after_new_scene
+    answered = Scene(objects=["green block", "yellow block", "pink bowl"])
+    refused = Scene(objects=["cyan block", "purple block", "gray bowl"])
+    first = learner.design_scene()  # nothing answered yet: the belief's candidates
+    learner.observations += [Observation(answered, Answer(signal="stop"), []),
+                             Observation(refused, Answer(signal="stop", new_scene=True), [])]
+    assert [learner.design_scene().objects for _ in range(3)] == [answered.objects] * 3
+    learner.observations.append(Observation(answered, Answer(signal="stop", new_scene=True), []))  # refused later
+    again = learner.design_scene().objects
+    assert again not in (answered.objects, refused.objects) and first is not None
