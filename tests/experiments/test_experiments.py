@@ -27,7 +27,8 @@ EPISODES = {
     "reward-variants/noplanner.py": ("reward-stop-noplanner", "color-match", None),
     "grammar-intentions/grammar_intentions.py": ("bayes-stop", None, f"{GRAMMAR}:PINK_BOWL"),
 }
-SCRIPTS = {"decide/clairvoyant_bound.py", "defaults/compare.py", "answered-scenes/compare.py"}  # their own command line
+SCRIPTS = {"decide/clairvoyant_bound.py", "defaults/compare.py", "defaults/compare_bayes.py",
+           "answered-scenes/compare.py"}  # their own command line
 DESIGNS = {"answered-scenes/answered.py": "answered"}  # plug-in file → the scene design it registers
 HELPERS = {"decide/acquisition.py", "decide/decision.py", "decide/needs.py", "decide/plans.py"}  # loaded by the above
 
