@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from activeintent import ranking
 from activeintent.goals import planner
@@ -83,6 +83,11 @@ class DecideConfig(LangConfig):
     lookahead: int = Field(1, ge=1, le=2, description="2: a query valued with the best next one")
     final_joint: int = Field(0, ge=0, le=8, description="the final answer may run a plan for two likely goals")
     pool: int = Field(0, ge=0, description="after each answer, this many one-clause goals above the cut join")
+
+    @field_validator("scenes")
+    @classmethod
+    def _known_design(cls, name: str) -> str:  # decide's own designs, above; not SCENE_DESIGNS
+        return name
 
 
 @dataclass

@@ -43,7 +43,7 @@ def test_belief_scenes_can_show_what_the_belief_expects_sampled_ones_mostly_cann
 
 
 def test_belief_scenes_also_follow_a_new_scene_answer_sampled_ones_do_not():
-    assert set(SCENE_DESIGNS) == {"sampled", "belief"}
+    assert {"sampled", "belief"} <= set(SCENE_DESIGNS)  # a plug-in loaded by another test may add its own
     for method in ("lang-stop", "bayes-preference"):
         assert get_method(method)(LearnerContext(config=LearnerConfig(method=method, scenes="belief"))).redesigns_after_new_scene
         assert not get_method(method)(LearnerContext(config=LearnerConfig(method=method))).redesigns_after_new_scene
