@@ -48,6 +48,17 @@ def test_layering(package, forbidden):
     assert not bad, f"{package} must not import {forbidden}: {bad}"
 
 
+def test_commands_live_in_cli_and_the_library_never_imports_it():
+    """One module per command group under cli/; the library below defines no command (no typer)
+    and never imports the command line."""
+    commands = [name for name, path in MODULES.items() if not name.startswith("activeintent.cli")
+                and re.search(r"^\s*(import typer|from typer)", path.read_text(), re.M)]
+    assert not commands, f"commands outside activeintent.cli: {commands}"
+    upward = [(name, imp) for name, path in MODULES.items() if not name.startswith("activeintent.cli")
+              for imp in imports(path) if imp.startswith("activeintent.cli")]
+    assert not upward, f"the library imports the command line: {upward}"
+
+
 def _is_type_checking(node: ast.AST) -> bool:
     test = node.test if isinstance(node, ast.If) else None
     return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or (

@@ -59,7 +59,7 @@ def test_failed_model_calls_show_while_running_and_in_the_summary(tmp_path):
     text = " ".join(res.output.split())
     assert "model call failed" in text and "nothing answers at http://127.0.0.1:9/v1" in text
     assert res.exit_code == 3  # the model never answered
-    from activeintent.run_command import model_summary
+    from activeintent.cli.run import model_summary
 
     assert "2 failed" in model_summary("embedded", 5, ["timeout", "timeout"])
     assert model_summary("none", 0, []) == "no model (--llm none)"
@@ -115,7 +115,7 @@ def test_table_row_k_shows_round_k_answer_and_the_estimate_after_it():
     not (slow learners are scored at k = K only)."""
     from types import SimpleNamespace
 
-    from activeintent.run_command import LiveTable, plain_console
+    from activeintent.cli.run import LiveTable, plain_console
 
     final = SimpleNamespace(final_z="z after 2", final_goal="g", final_scene=0, success=1.0)
     live = LiveTable(plain_console(), "bayes-stop", 2, 0, lines=False)
@@ -141,7 +141,7 @@ def test_table_row_k_shows_round_k_answer_and_the_estimate_after_it():
 def test_user_strings_print_without_markup_and_messages_whole():
     import io
 
-    from activeintent.run_command import model_summary, plain_console
+    from activeintent.cli.run import model_summary, plain_console
 
     console = plain_console()
     console.file = io.StringIO()

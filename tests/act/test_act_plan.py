@@ -10,10 +10,10 @@ from act_helpers import require_namespaces
 from pydantic import ValidationError
 from typer.testing import CliRunner
 
-from activeintent.act.commands import register
 from activeintent.act.executors import make_executor
 from activeintent.act.failures import ExecutionFailure
 from activeintent.act.plan import PlanExecutor, plan_schema
+from activeintent.cli.act_bench import register
 from activeintent.llm.scripted import ScriptedModel
 from activeintent.world import PutAt, PutIn, PutNextTo, PutOn, Scene, WorldState, layout
 

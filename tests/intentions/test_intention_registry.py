@@ -8,6 +8,7 @@ import pytest
 import typer
 from typer.testing import CliRunner
 
+from activeintent.cli.intentions import register
 from activeintent.intentions import (
     INTENTION_NAMES,
     PAPER_INTENTIONS,
@@ -17,7 +18,6 @@ from activeintent.intentions import (
     load_intention_file,
     resolve_intention,
 )
-from activeintent.intentions.commands import register
 from activeintent.world import WorldState, apply_plan, layout
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "my_intention.py"

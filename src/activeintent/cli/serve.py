@@ -9,8 +9,8 @@ from typing import Annotated
 
 import typer
 
-from activeintent import options as opt
-from activeintent.options import D
+from activeintent.cli import options as opt
+from activeintent.cli.options import D
 from activeintent.web.basics import VIDEO_SIZE_TEXT
 
 
@@ -23,9 +23,6 @@ class ShowEstimate(StrEnum):
 def register(app: typer.Typer) -> None:
     app.command(name="serve")(serve)
     app.command(name="study-export")(study_export)
-    from activeintent.web.wait_bench import web_bench
-
-    app.command(name="web-bench")(web_bench)
 
 
 def serve(

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import typer
 
-from activeintent import options as opt
-from activeintent.options import D
+from activeintent.cli import options as opt
+from activeintent.cli.options import D
 
 
 def register(app: typer.Typer) -> None:

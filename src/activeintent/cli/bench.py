@@ -7,8 +7,8 @@ from typing import Annotated
 
 import typer
 
-from activeintent import options as opt
-from activeintent.options import D
+from activeintent.cli import options as opt
+from activeintent.cli.options import D
 
 
 def register(app: typer.Typer) -> None:

@@ -1,4 +1,5 @@
-"""The `activeintent` command line. Each area registers its own commands (imports stay lazy)."""
+"""The `activeintent` command line: one module per command group, each with ``register(app)``;
+the library below never defines a command."""
 
 from __future__ import annotations
 
@@ -17,18 +18,19 @@ app = typer.Typer(
 
 # Each module defines register(app) and adds its commands.
 _COMMAND_MODULES = (
-    "activeintent.run_command",
-    "activeintent.act.commands",
-    "activeintent.bench.commands",
-    "activeintent.bench.perf",
-    "activeintent.bench.verify",
-    "activeintent.goals.commands",
-    "activeintent.intentions.commands",
-    "activeintent.learners.commands",
-    "activeintent.learners.bayes.commands",
-    "activeintent.llm.commands",
-    "activeintent.sim.commands",
-    "activeintent.web.commands",
+    "activeintent.cli.run",
+    "activeintent.cli.bench",
+    "activeintent.cli.verify",
+    "activeintent.cli.perf_bench",
+    "activeintent.cli.serve",
+    "activeintent.cli.web_bench",
+    "activeintent.cli.methods",
+    "activeintent.cli.intentions",
+    "activeintent.cli.hypotheses",
+    "activeintent.cli.prior",
+    "activeintent.cli.models",
+    "activeintent.cli.act_bench",
+    "activeintent.cli.sim",
 )
 
 for _module in _COMMAND_MODULES:
@@ -42,7 +44,7 @@ _MEASURING = {"coverage", "sim-demo", "sim-bench", "model-bench", "act-bench", "
 def _checked(callback):
     @functools.wraps(callback)
     def wrapper(*args, **kwargs):
-        from activeintent.options import check_only
+        from activeintent.cli.options import check_only
 
         if check_only():
             return None
@@ -55,6 +57,3 @@ for _info in app.registered_commands:
     if (_info.name or "") in _MEASURING:
         _info.callback = _checked(_info.callback)
 
-
-if __name__ == "__main__":
-    app()

@@ -1,0 +1,5 @@
+"""``python -m activeintent.cli``."""
+
+from activeintent.cli import app
+
+app()
