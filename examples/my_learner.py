@@ -8,7 +8,8 @@ Bayesian learner's.
 
 A learner is a class with ``design_scene``, ``estimate``, ``observe`` and ``final``
 (``activeintent.learners.base.Learner``); a method is its registry entry: the signal it reads,
-whether it needs a model, how to build it from a ``LearnerContext`` (seeds, models, settings).
+whether it needs a model, how to build it from a ``LearnerContext`` (seeds, models, settings),
+and how reports show it (its colour, the method it is paired with on the same trials).
 """
 
 from __future__ import annotations
@@ -49,7 +50,9 @@ def _method(signal: str) -> Method:
     def build(ctx: LearnerContext) -> GreedyLearner:
         return GreedyLearner(signal, rng=ctx.learner_seed)
 
-    return Method(signal, False, build, f"example: shows the plans of its likeliest goals ({signal})")
+    # reports pair it with bayes-<signal> (everything but the query choice is the same) and draw it in this colour
+    return Method(signal, False, build, f"example: shows the plans of its likeliest goals ({signal})",
+                  colour="#393b79", compared_with=f"bayes-{signal}")
 
 
 for _signal in ("stop", "preference"):

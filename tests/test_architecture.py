@@ -40,7 +40,7 @@ MODULES = {module_name(p): p for p in SRC.rglob("*.py")}
     ("activeintent.intentions", ("activeintent.learners", "activeintent.users", "activeintent.sim")),
     ("activeintent.goals", ("activeintent.learners", "activeintent.users", "activeintent.sim", "activeintent.intentions")),
     # written blind with the world's helpers only: expressible in the language is measured, not built in
-    ("activeintent.intentions.suites.heldout", ("activeintent.goals",)),
+    ("activeintent.suites.heldout", ("activeintent.goals",)),
 ])
 def test_layering(package, forbidden):
     bad = [(name, imp) for name, path in MODULES.items() if name.startswith(package)
@@ -57,6 +57,62 @@ def test_commands_live_in_cli_and_the_library_never_imports_it():
     upward = [(name, imp) for name, path in MODULES.items() if not name.startswith("activeintent.cli")
               for imp in imports(path) if imp.startswith("activeintent.cli")]
     assert not upward, f"the library imports the command line: {upward}"
+
+
+# The layers, bottom first: a module imports only from its own part (a top-level module or
+# package) and from parts of lower layers, at any depth (inside functions and under
+# TYPE_CHECKING too). docs/architecture.md draws the same order.
+LAYERS = (
+    ("registry", "memo", "provenance", "progress_lines", "ranking", "llm"),
+    ("world",),
+    ("act", "goals", "protocol", "signals", "sim"),
+    ("envs", "intentions", "records", "spec"),
+    ("learners", "results", "users"),
+    ("scoring",),
+    ("episode", "suites"),
+    ("runner",),
+    ("bench", "web"),
+    ("cli",),
+)
+LAYER = {part: i for i, parts in enumerate(LAYERS) for part in parts}
+
+
+def part_of(module: str) -> str:
+    return module.split(".")[1] if module.count(".") else module
+
+
+def test_every_import_runs_down_the_layers():
+    parts = {part_of(name) for name in MODULES} - {"activeintent", "prompts"}
+    assert parts <= set(LAYER), f"parts without a layer: {sorted(parts - set(LAYER))}"
+    upward = sorted((name, imp) for name, path in MODULES.items() for imp in imports(path)
+                    if part_of(name) != part_of(imp) and part_of(imp) in LAYER and part_of(name) in LAYER
+                    and LAYER[part_of(imp)] >= LAYER[part_of(name)])
+    assert not upward, f"imports that do not run down the layers: {upward}"
+
+
+def test_function_level_project_imports_are_few_and_say_why():
+    """Imports of the project inside functions only keep a heavy dependency (PyBullet, FastAPI, the
+    openai SDK) off paths that do not need it; each block says so in a ``# lazy:`` line above it."""
+    found, unexplained = set(), []
+    for name, path in MODULES.items():
+        lines = path.read_text().splitlines()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                continue
+            for stmt in ast.walk(node):
+                if (name, getattr(stmt, "lineno", 0)) in found:
+                    continue
+                if isinstance(stmt, (ast.Import, ast.ImportFrom)) and any(
+                        m.startswith("activeintent") for m in
+                        ([stmt.module or ""] if isinstance(stmt, ast.ImportFrom) else [a.name for a in stmt.names])):
+                    found.add((name, stmt.lineno))
+                    above = stmt.lineno - 2
+                    while above >= 0 and re.match(r"\s*(from|import) ", lines[above]):
+                        above -= 1
+                    if above < 0 or "# lazy:" not in lines[above]:
+                        unexplained.append(f"{name}:{stmt.lineno}")
+    assert len(found) <= 30, f"{len(found)} function-level project imports (at most 30)"
+    assert not unexplained, f"function-level imports without a '# lazy:' reason above them: {unexplained}"
 
 
 def _is_type_checking(node: ast.AST) -> bool:
@@ -240,7 +296,7 @@ def _language_calls(call) -> set[str]:
 
 def _library_and_dev_intentions():
     from activeintent.intentions.registry import INTENTION_NAMES, get_intention
-    from activeintent.intentions.suites.dev import dev_intentions
+    from activeintent.suites.dev import dev_intentions
 
     return [get_intention(n) for n in INTENTION_NAMES] + dev_intentions()
 
@@ -293,11 +349,11 @@ def test_held_out_suites_stay_independent_of_the_goal_language(suite):
     """Written blind with the world's helpers only (also at run time: lazy imports count, and
     the modules they import, transitively), so that whether the language can say them is
     measured, not true by construction."""
-    path = SRC / "intentions" / "suites" / f"{suite}.py"
+    path = SRC / "suites" / f"{suite}.py"
     assert path.exists()
     found = imports(path) | runtime_imports(path)
     assert not [m for m in found if m.startswith("activeintent.goals")], found
-    closure = module_closure(f"activeintent.intentions.suites.{suite}")
+    closure = module_closure(f"activeintent.suites.{suite}")
     assert {"activeintent.intentions.base", "activeintent.intentions.blockwise", "activeintent.intentions.placement",
             "activeintent.world"} <= set(closure)  # the walk reaches the helpers they share
     via = {m: closure[m] for m in closure if m.startswith("activeintent.goals")}

@@ -24,7 +24,7 @@ def pool(trial: int, bench_seed: int = 0) -> list:
     return [s for s, _ in scenes]
 
 
-# truth-goals: 50 planner-judged goals × 20 pools take about 100 s (bench/truth_goals.py's draw
+# truth-goals: 50 planner-judged goals × 20 pools take about 100 s (suites/truth_goals.py's draw
 # keeps only goals that pass this check, so it fails only if the planner or the scenes change)
 @pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n == "truth-goals" else n
                                   for n in SUITE_NAMES])

@@ -327,8 +327,11 @@ def decide_method(signal: str, name: str | None = None, keep: int = KEEP, descri
         learner.name = name
         return learner
 
+    main = name == f"decide-{signal}"  # its ablations and variants are compared in their own README
     return Method(signal, False, build, description or f"experiment: the goal-language belief, scenes designed "
-                  f"from it, {signal} queries by information about the decision", goal_language=True)
+                  f"from it, {signal} queries by information about the decision", goal_language=True,
+                  colour={"stop": "#d62728", "preference": "#ff9896"}[signal] if main else None,
+                  compared_with=f"lang-{signal}" if main else None)
 
 
 for _signal in ("stop", "preference"):

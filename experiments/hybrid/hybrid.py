@@ -153,7 +153,8 @@ def hybrid_method(signal: str, decision: str = "mixture") -> Method:
                              decision=decision)
 
     return Method(signal, False, build, f"ours: lang-{signal}'s belief and queries with a reward-feature "
-                  "component that answers when it explains the answers better", goal_language=True)
+                  "component that answers when it explains the answers better", goal_language=True,
+                  compared_with=f"lang-{signal}")
 
 
 for _signal in ("preference", "stop"):

@@ -28,7 +28,8 @@ def _noplanner(signal: str) -> Method:
     def build(ctx: LearnerContext) -> RewardLearner:
         return NoPlannerRewardLearner(signal, rng=ctx.learner_seed)
 
-    return Method(signal, False, build, f"ablation of reward-{signal}: candidates without the Bayesian planner", "peer")
+    return Method(signal, False, build, f"ablation of reward-{signal}: candidates without the Bayesian planner", "peer",
+                  colour={"preference": "#dbdb8d", "stop": "#9edae5"}[signal])
 
 
 for _signal in ("preference", "stop"):

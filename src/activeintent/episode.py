@@ -154,7 +154,8 @@ class Episode:
     def video(self, traj: Trajectory, name: str, stop_time: float | None = None) -> None:
         if self.out is None or not self.env.renders or traj.renderer is None:
             return
-        from activeintent.sim.video import export_video  # only envs that render reach here
+        # lazy: PyBullet loads only for envs that render
+        from activeintent.sim.video import export_video
 
         self.clock.timed("video_s", export_video, traj, self.out / f"{name}.gif", fps=self.protocol.video_fps,
                          stop_time=stop_time)

@@ -17,7 +17,7 @@ from pathlib import Path
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from activeintent.protocol import FORMAT_VERSION
-from activeintent.records import dumps
+from activeintent.records import EpisodeResult, dumps
 
 
 class ErrorRecord(BaseModel):
@@ -37,8 +37,6 @@ class ErrorRecord(BaseModel):
 def _result_model() -> type[BaseModel]:
     """A results line of a finished episode: its EpisodeResult (without the per-scene tests)
     plus the bench's trial. Strict: a number written as a string is not a number."""
-    from activeintent.records import EpisodeResult
-
     class ResultRecord(EpisodeResult):
         model_config = ConfigDict(strict=True, extra="allow")
 

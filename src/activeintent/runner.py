@@ -10,8 +10,19 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from activeintent.act.executors import EXECUTORS, make_executor
+from activeintent.envs import ENVS, make_env
 from activeintent.episode import Episode
+from activeintent.goals.prior import load_prior
+from activeintent.learners.bayes.scenes import SCENE_DESIGNS
+from activeintent.learners.registry import LearnerContext, get_method
+from activeintent.llm.embedded import EmbeddedConfig
+from activeintent.llm.registry import load_model, parse_spec
+from activeintent.registry import load_plugin
 from activeintent.spec import DEFAULT_INTENTION, DEFAULT_METHOD, ModelsConfig, RunSpec
+from activeintent.suites import resolve as resolve_intention
+from activeintent.suites.truth_goals import truth_tracker
+from activeintent.users.simulated import USER_PRESETS, SimulatedUser, user_profile
 
 __all__ = ["DEFAULT_INTENTION", "DEFAULT_METHOD", "Models", "RunSpec", "build_episode", "check_spec", "with_method_defaults"]
 
@@ -30,8 +41,6 @@ class Models:
         if spec is None or spec == "none":
             return None
         if spec not in self._loaded:
-            from activeintent.llm.registry import load_model
-
             c = self.config
             self._loaded[spec] = load_model(spec, base_url=c.base_url, cache_path=c.cache, cache_mode=c.cache_mode)
         return self._loaded[spec]
@@ -55,9 +64,6 @@ class Models:
             return self.llm
         key = f"{spec}#executor"
         if key not in self._loaded:
-            from activeintent.llm.embedded import EmbeddedConfig
-            from activeintent.llm.registry import load_model
-
             c = self.config
             self._loaded[key] = load_model(spec, base_url=c.base_url, cache_path=c.cache, cache_mode=c.cache_mode,
                                            embedded=EmbeddedConfig(kv_slot="executor", n_ctx=EXECUTOR_CTX))
@@ -79,8 +85,6 @@ def with_method_defaults(spec: RunSpec) -> RunSpec:
     what a record keeps is what ran."""
     if spec.learner.prior is not None:
         return spec
-    from activeintent.learners.registry import get_method
-    from activeintent.registry import load_plugin
 
     for path in spec.plugins:
         load_plugin(path)
@@ -90,21 +94,11 @@ def with_method_defaults(spec: RunSpec) -> RunSpec:
 def check_spec(spec: RunSpec) -> RunSpec:
     """Refuse, before any work, a spec that cannot run; messages name the option and list choices.
     Returns the spec that will run (the method's defaults filled in: :func:`with_method_defaults`)."""
-    from activeintent.act.executors import EXECUTORS
-    from activeintent.envs import ENVS
-    from activeintent.learners.bayes.scenes import SCENE_DESIGNS
-    from activeintent.learners.registry import get_method
-    from activeintent.llm.registry import parse_spec
-    from activeintent.registry import load_plugin
-    from activeintent.users.simulated import USER_PRESETS
-
     for path in spec.plugins:
         load_plugin(path)
     method = get_method(spec.learner.method)
     spec = with_method_defaults(spec)
     if spec.learner.prior not in ("length", "uniform"):
-        from activeintent.goals.prior import load_prior
-
         if not method.goal_language:
             raise ValueError(f"--prior {spec.learner.prior}: a fitted prior is over the goal language; "
                              f"{spec.learner.method} takes length or uniform (lang-* take fitted and file:PATH)")
@@ -132,12 +126,6 @@ def build_episode(
 ) -> Episode:
     """Everything before the loop starts. Errors in the spec are raised here, before any work.
     ``show_final``: see :class:`Episode` (the web study's final attempt; None for every run)."""
-    from activeintent.act.executors import make_executor
-    from activeintent.envs import make_env
-    from activeintent.learners.registry import LearnerContext, get_method
-    from activeintent.suites import resolve as resolve_intention
-    from activeintent.users.simulated import SimulatedUser, user_profile
-
     spec = check_spec(spec)
     learning, who = spec.learner, spec.user
     method = get_method(learning.method)
@@ -154,7 +142,6 @@ def build_episode(
             user.profile = user.profile.model_copy(update={"new_scene_false": 0.0, "new_scene_miss": 1.0})
     observers = list(observers or [])
     if getattr(intention, "goal", None) is not None:  # a goal as the hidden intention: track p(goal)
-        from activeintent.bench.truth_goals import truth_tracker
 
         if (tracker := truth_tracker(learner, intention)) is not None:
             observers.append(tracker)

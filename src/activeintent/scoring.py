@@ -6,16 +6,38 @@ answered; success is the share of feasible scenes satisfied. The episode decides
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Callable
+from typing import Any, Protocol
 
 import numpy as np
 
+from activeintent.envs import Env
 from activeintent.intentions.base import Intention
+from activeintent.learners.base import Estimate, Learner
 from activeintent.records import TestLog
+from activeintent.spec import ProtocolConfig
 from activeintent.world import Scene, WorldState, apply_plan, describe_plan, layout
+from activeintent.world.trajectory import Trajectory
 
-if TYPE_CHECKING:
-    from activeintent.episode import Episode
+
+class ScoredEpisode(Protocol):
+    """What the scorer reads of an episode (``episode.Episode`` is one): scoring sits below the
+    loop that calls it."""
+
+    clock: Any
+    env: Env
+    intention: Intention
+    learner: Learner
+    protocol: ProtocolConfig
+    show_final: str | None
+
+    def emit(self, event: str, *args) -> None: ...
+
+    def executor_calls(self) -> list[dict]: ...
+
+    def ground(self, ask: Callable[[Scene, WorldState], Estimate], scene: Scene, state: WorldState) -> tuple: ...
+
+    def video(self, traj: Trajectory, name: str, stop_time: float | None = None) -> None: ...
 
 
 def first_feasible(intention: Intention, tests: list[tuple[Scene, int]]) -> int:
@@ -27,7 +49,7 @@ class Scorer:
     """Scores an episode's learner on its test scenes (uses the episode's learner, executor,
     env, intention, clock and observers)."""
 
-    def __init__(self, episode: Episode):
+    def __init__(self, episode: ScoredEpisode):
         self.episode = episode
 
     def score(self, k: int, tests: list[tuple[Scene, int]], final: bool) -> tuple[float | None, list[TestLog]]:

@@ -37,11 +37,11 @@ def test_intention_file_alone_runs_just_that_intention_named_by_its_name(tmp_pat
 
 
 def test_a_named_suite_still_runs_beside_an_intention_file(tmp_path, monkeypatch):
-    import activeintent.bench.runner as bench_runner
+    import activeintent.cli.bench as bench_command
     from activeintent.suites import suite
 
     asked = []
-    monkeypatch.setattr(bench_runner, "run_bench", lambda options, out, *hooks: asked.append(options) or [])
+    monkeypatch.setattr(bench_command, "run_bench", lambda options, out, *hooks: asked.append(options) or [])
     res = runner.invoke(app, ["bench", "--methods", "zero-signal", "--suite", "paper", "--intention-file", MINE,
                               *TINY, "--out", str(tmp_path)])
     assert res.exit_code == 0, res.output

@@ -4,13 +4,14 @@ multiples, intervals in every table, paired comparisons against the best baselin
 from __future__ import annotations
 
 import re
+from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from activeintent.bench import report
 from activeintent.bench.report import (
-    BASELINES,
     PANEL_METHODS,
     method_colour,
     paired_bootstrap,
@@ -141,7 +142,7 @@ def test_every_method_is_paired_against_the_best_baseline(tmp_path):
     assert [r.split(" | ")[0] for r in rows] == ["| bayes-stop − random-query", "| lang-stop − random-query"]
     lang = rows[1]
     assert "8 / 0 / 0" in lang and f"{sign_test(8, 0):.3g}" in lang
-    assert all(m not in BASELINES for m in ("bayes-stop", "lang-stop"))
+    assert not any(report.is_baseline(m) for m in ("bayes-stop", "lang-stop"))
 
 
 def paired_rows(methods: list[str], tmp_path) -> tuple[str, list[str]]:
@@ -183,6 +184,25 @@ def test_unscored_episodes_count_in_signals_answers_and_excluded_scenes(tmp_path
 
 
 def test_a_hybrid_is_paired_with_the_language_learner_it_extends(tmp_path):
+    from activeintent.registry import load_plugin
+
+    load_plugin(Path(__file__).resolve().parents[2] / "experiments" / "hybrid" / "hybrid.py")  # as bench --plugin does
     section, rows = paired_rows(["lang-stop", "hybrid-stop", "hybrid-stop-map", "zero-signal"], tmp_path)
     assert "decide and hybrid against lang" in section
     assert "| hybrid-stop − lang-stop" in rows and "| hybrid-stop-map − lang-stop" in rows
+
+
+def test_a_plug_in_method_brings_its_colour_and_its_pairing_in_its_registry_entry(monkeypatch, tmp_path):
+    """Report colours and fixed pairs come from the methods' registry entries: a plug-in that
+    registers a method with a colour and a method to compare with needs no change to the report."""
+    from activeintent.learners.registry import METHODS, get_method
+
+    base = get_method("bayes-stop")
+    twin = replace(base, help="a plug-in twin of bayes-stop", colour="#123456", compared_with="bayes-stop")
+    monkeypatch.setitem(METHODS._factories, "my-twin-stop", lambda: twin)
+    assert report.method_colour("my-twin-stop") == "#123456"
+    assert report.fixed_pairs(["my-twin-stop", "bayes-stop", "random-query"]) == [
+        ("my-twin-stop", "bayes-stop"), ("bayes-stop", "random-query")]
+    section, rows = paired_rows(["my-twin-stop", "bayes-stop", "zero-signal"], tmp_path)
+    assert "| my-twin-stop − bayes-stop" in rows
+    assert report.is_baseline("lang-zero-signal") and not report.is_baseline("lang-stop")

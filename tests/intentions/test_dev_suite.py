@@ -1,4 +1,4 @@
-"""The dev suite (intentions/suites/dev.py): sampled scenes are feasible, oracle plans reach the intention
+"""The dev suite (suites/dev.py): sampled scenes are feasible, oracle plans reach the intention
 in the symbolic world model, hand-built states are judged as a person would, and the suite
 resolves everywhere an intention name is accepted."""
 
@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from activeintent.intentions import INTENTION_NAMES
-from activeintent.intentions.suites.dev import dev_intentions
 from activeintent.suites import SUITE_NAMES, resolve, suite, suite_of
+from activeintent.suites.dev import dev_intentions
 from activeintent.world import (
     PutAt,
     PutIn,

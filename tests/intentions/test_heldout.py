@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from activeintent.intentions import INTENTION_NAMES
-from activeintent.intentions.suites import heldout
-from activeintent.intentions.suites.heldout import HELDOUT_INTENTIONS, heldout_intentions
+from activeintent.suites import heldout
+from activeintent.suites.heldout import HELDOUT_INTENTIONS, heldout_intentions
 from activeintent.world import (
     PutAt,
     PutIn,

@@ -1,4 +1,4 @@
-"""The heldout2 suite (intentions/suites/heldout2.py): registered as its own suite; for every
+"""The heldout2 suite (suites/heldout2.py): registered as its own suite; for every
 intention, on 20 scenes of its own sampler, the oracle plan run through the world model satisfies
 it (score 1.0) without a step that moves away, and the initial layout seldom does; hand-built
 boundary states that nearly satisfy an intention do not."""
@@ -6,8 +6,8 @@ boundary states that nearly satisfy an intention do not."""
 import numpy as np
 import pytest
 
-from activeintent.intentions.suites.heldout2 import HELDOUT2, heldout2_intentions
 from activeintent.suites import SUITE_NAMES, resolve, suite, suite_of
+from activeintent.suites.heldout2 import HELDOUT2, heldout2_intentions
 from activeintent.world import (
     PutAt,
     PutIn,
@@ -284,7 +284,7 @@ def test_the_suite_is_written_with_the_world_and_intention_helpers_only():
     import ast
     from pathlib import Path
 
-    import activeintent.intentions.suites.heldout2 as module
+    import activeintent.suites.heldout2 as module
 
     tree = ast.parse(Path(module.__file__).read_text())
     imported = [n.module or "" for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]

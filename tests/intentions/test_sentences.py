@@ -9,8 +9,8 @@ import pytest
 
 from activeintent.intentions import all_intentions, get_intention
 from activeintent.intentions.placement import is_warm
-from activeintent.intentions.suites.dev import dev_intentions
 from activeintent.protocol import sample_test_scene
+from activeintent.suites.dev import dev_intentions
 from activeintent.world import (
     PutAt,
     PutIn,

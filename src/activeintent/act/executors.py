@@ -7,7 +7,9 @@ from __future__ import annotations
 from typing import Any
 
 from activeintent.act.base import Executor
+from activeintent.act.cap import CapExecutor
 from activeintent.act.failures import PlanResult
+from activeintent.act.plan import PlanExecutor
 from activeintent.llm.base import ChatModel
 from activeintent.registry import Registry
 from activeintent.world.state import WorldState
@@ -31,15 +33,11 @@ def _parse(model: ChatModel | None = None, *, parser_first: bool = False, **opti
 
 @EXECUTORS.register("plan", help="the model writes the plan as JSON skills")
 def _plan(model: ChatModel | None = None, *, parser_first: bool = False, **options: Any) -> Executor:
-    from activeintent.act.plan import PlanExecutor
-
     return PlanExecutor(model, parser_first=parser_first, **options)
 
 
 @EXECUTORS.register("cap", help="Code as Policies: the model writes a program, run in the sandbox")
 def _cap(model: ChatModel | None = None, *, parser_first: bool = False, **options: Any) -> Executor:
-    from activeintent.act.cap import CapExecutor
-
     return CapExecutor(model, parser_first=parser_first, **options)
 
 

@@ -2,6 +2,13 @@
 
 from __future__ import annotations
 
+from activeintent.act.failures import check_plan
+from activeintent.act.parse import parse_instruction
+from activeintent.act.plan import answer_to_plan, plan_schema
+from activeintent.act.robot_api import RobotAPI, safe_builtins
+from activeintent.act.sandbox import Sandbox
+from activeintent.world import PutIn, PutOn, WorldState, describe_plan, layout, sample_scene
+
 # Programs in the Code-as-Policies style, used to measure the sandbox's cost per program.
 BENCH_PROGRAMS = (
     "say('Ok')\nput_first_on_second(BLOCKS[0], BOWLS[0])",
@@ -23,13 +30,6 @@ def run_bench(n_programs: int = 20, seed: int = 0) -> dict:
     import time
 
     import numpy as np
-
-    from activeintent.act.failures import check_plan
-    from activeintent.act.parse import parse_instruction
-    from activeintent.act.plan import answer_to_plan, plan_schema
-    from activeintent.act.robot_api import RobotAPI
-    from activeintent.act.sandbox import Sandbox
-    from activeintent.world import PutIn, PutOn, WorldState, describe_plan, layout, sample_scene
 
     rng = np.random.default_rng(seed)
     states = []
@@ -61,8 +61,6 @@ def run_bench(n_programs: int = 20, seed: int = 0) -> dict:
     programs = [(program(i, s), s) for i, s in enumerate(states)]
 
     def in_process(ps) -> None:
-        from activeintent.act.robot_api import safe_builtins
-
         api = RobotAPI(ps[1])
         ns = api.namespace()
         ns["__builtins__"] = safe_builtins(api)

@@ -14,7 +14,7 @@ from pydantic import BaseModel, Field, TypeAdapter, ValidationError, create_mode
 
 from activeintent.act.base import Executor, render_prompt
 from activeintent.act.failures import ExecutionFailure, PlanResult
-from activeintent.llm.base import ChatModel, ModelError
+from activeintent.llm.base import ChatModel, Message, ModelError
 from activeintent.world.relations import describe_state
 from activeintent.world.skills import TABLE_POSITIONS, Skill
 from activeintent.world.state import WorldState
@@ -82,8 +82,6 @@ class PlanExecutor(Executor):
         self.max_tokens = max_tokens
 
     def messages(self, instruction: str, state: WorldState) -> tuple[list, str]:
-        from activeintent.llm.base import Message
-
         prompt, version = render_prompt(
             "executor_plan",
             objects=", ".join(state.names),

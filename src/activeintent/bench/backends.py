@@ -15,6 +15,8 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from activeintent.bench.work import protocol_fields, run_item
+
 if TYPE_CHECKING:
     from activeintent.bench.work import BenchConfig, WorkItem
 
@@ -44,8 +46,6 @@ def check_backend(name: str) -> None:
 
 def worker_died(item: WorkItem, options: BenchConfig, why: str = "worker process died") -> dict:
     """The record of an episode whose worker ended without an answer (e.g. a native crash)."""
-    from activeintent.bench.work import protocol_fields
-
     return {"method": item.method, "intention": item.intention, "trial": item.trial,
             **protocol_fields(options.run), "success": None, "error": why}
 
@@ -82,8 +82,6 @@ def execute_ray(todo: list[WorkItem], options: BenchConfig, out: Path) -> Iterat
     """Yield one record per episode of ``todo``, in the order they finish."""
     import ray
     from ray.exceptions import RayError, RayTaskError
-
-    from activeintent.bench.work import run_item
 
     if not todo:
         return

@@ -24,6 +24,7 @@ from pathlib import Path
 
 from activeintent.bench.work import BenchConfig, protocol_fields
 from activeintent.protocol import FORMAT_VERSION, trial_seeds
+from activeintent.runner import with_method_defaults
 from activeintent.spec import EpisodeSeeds
 
 _HEX40 = re.compile(r"[0-9a-f]{40}")
@@ -58,8 +59,6 @@ class Plan:
         """The settings a line of ``method`` records (its own prior where the folder leaves it open)."""
         got = self._fields.get(method)
         if got is None:
-            from activeintent.runner import with_method_defaults
-
             got = self._fields[method] = protocol_fields(with_method_defaults(self.run.with_options(method=method)))
         return got
 

@@ -41,7 +41,8 @@ from activeintent.goals.language import Goal, all_clauses, parse_goal, spoken
 from activeintent.goals.planner import generic_moves, plan
 from activeintent.goals.prior import FittedPrior, goal_bits, load_prior
 from activeintent.intentions.base import Intention
-from activeintent.learners.lang.space import Compiled
+from activeintent.learners.lang.learner import KEEP
+from activeintent.learners.lang.space import Compiled, cache_path, cached_json, space_info
 from activeintent.protocol import sample_test_scene, stable_seed
 from activeintent.suites import is_held_out
 from activeintent.world import Scene, WorldState, apply_skill, layout
@@ -361,8 +362,6 @@ def cached_coverage(intention: Intention, seed: int = 0) -> dict:
     import inspect
     from pathlib import Path
 
-    from activeintent.learners.lang.space import cache_path, cached_json
-
     try:
         source = inspect.getsource(type(intention))
     except (OSError, TypeError):
@@ -385,9 +384,6 @@ def oracle_of(intentions: dict[str, Intention], progress: Callable[[str], None] 
 
 def start_space_info(prior: FittedPrior | None = None) -> dict:
     """The lang learners' starting space under ``prior`` (None: description length)."""
-    from activeintent.learners.lang.learner import KEEP
-    from activeintent.learners.lang.space import space_info
-
     return space_info(0, KEEP, prior=prior)
 
 

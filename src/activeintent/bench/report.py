@@ -9,7 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
-from activeintent.suites import suite_of
+from activeintent.learners.base import Method
+from activeintent.learners.registry import METHODS, get_method
+from activeintent.results import REJECT_KINDS, rejected_counts
+from activeintent.suites import is_held_out, suite_of
 
 # The paper's Table 1: success judged by people, 5 trials each, 5 signals. Models per the paper's
 # §4.1: the LLM was gpt-4-1106-preview, the vision-language model gpt-4-vision-preview; the
@@ -33,33 +36,33 @@ def our_model(method: str, settings: dict) -> str:
         r = f"{vlm} (r)" if settings.get("retriever") == "vision" else "symbolic retriever (r)"
         return f"{r} + {llm} (z, y)"
     return str(llm)
-BASELINES = ("zero-signal", "random-query", "random-query-preference")
 
-# One colour per method in every figure of every report, fixed by name (not by the order a
-# bench lists its methods): the registered methods get their own tab20 entries (a baseline the
-# light shade of the learner whose belief it shares), any other name (a plug-in) one of the
-# remaining entries by a hash of its name.
-_TAB20 = ("#1f77b4", "#aec7e8", "#ff7f0e", "#ffbb78", "#2ca02c", "#98df8a", "#d62728", "#ff9896", "#9467bd",
-          "#c5b0d5", "#8c564b", "#c49c94", "#e377c2", "#f7b6d2", "#7f7f7f", "#c7c7c7", "#bcbd22", "#dbdb8d",
-          "#17becf", "#9edae5")
-METHOD_COLOURS = {
-    "bayes-stop": _TAB20[0], "random-query": _TAB20[1], "bayes-preference": _TAB20[2],
-    "random-query-preference": _TAB20[3], "lang-stop": _TAB20[4], "lang-preference": _TAB20[5],
-    "decide-stop": _TAB20[6], "decide-preference": _TAB20[7], "preference": _TAB20[8], "mllm": _TAB20[10],
-    "mllm-llm": _TAB20[12], "zero-signal": _TAB20[14],
-}
-_SPARE_COLOURS = tuple(c for c in _TAB20 if c not in METHOD_COLOURS.values())
-# The reward-learning peer (added later; the spare colours above, and so plug-ins' colours, stay as they were).
-METHOD_COLOURS.update({"reward-preference": _TAB20[16], "reward-preference-noplanner": _TAB20[17],
-                       "reward-stop": _TAB20[18], "reward-stop-noplanner": _TAB20[19]})
+
+# A method's colour is its registry entry's (Method.colour), the same in every figure of every
+# report; a method without one (a plug-in) gets one of the colours no built-in method uses, by a
+# hash of its name.
+_SPARE_COLOURS = ("#c5b0d5", "#c49c94", "#f7b6d2", "#c7c7c7", "#bcbd22", "#dbdb8d", "#17becf", "#9edae5")
+
+
+def _method(name: str) -> Method | None:
+    try:
+        return get_method(name)
+    except Exception:  # noqa: BLE001 - a plug-in method not loaded here
+        return None
+
+
+def is_baseline(name: str) -> bool:
+    """A baseline by its registry entry's family (zero-signal, lang-zero-signal, random-query…)."""
+    return getattr(_method(name), "family", None) == "baseline"
 
 
 def method_colour(method: str) -> str:
     """The method's colour, the same in every figure and run (hashlib, not hash(): that is salted per process)."""
     import hashlib
 
-    if method in METHOD_COLOURS:
-        return METHOD_COLOURS[method]
+    colour = (m := _method(method)) and m.colour
+    if colour:
+        return colour
     return _SPARE_COLOURS[int(hashlib.sha256(method.encode()).hexdigest(), 16) % len(_SPARE_COLOURS)]
 
 
@@ -97,12 +100,10 @@ def wilson(successes: float, n: int, z: float = 1.96) -> tuple[float, float]:
     return (max(0.0, centre - half), min(1.0, centre + half))
 
 
-# EIG learners and the baselines that share their belief but ask at random; the decision-aware
-# learners and the hybrids (experiments/hybrid/hybrid.py) against the language learners they extend.
-PAIRED = (("bayes-stop", "random-query"), ("bayes-preference", "random-query-preference"),
-          ("decide-stop", "lang-stop"), ("decide-preference", "lang-preference"),
-          ("hybrid-stop", "lang-stop"), ("hybrid-preference", "lang-preference"),
-          ("hybrid-stop-map", "lang-stop"), ("hybrid-preference-map", "lang-preference"))
+def fixed_pairs(methods: list[str]) -> list[tuple[str, str]]:
+    """(method, the method its registry entry is compared with) for the methods of a bench that
+    have both: EIG learners against their random-question twins, decide and hybrid against lang."""
+    return [(m, c) for m in methods if (c := getattr(_method(m), "compared_with", None)) and c in methods]
 
 
 def auc(curve: list[float | None]) -> float | None:
@@ -162,47 +163,38 @@ def paired_comparison(records: list[dict], a: str, b: str) -> dict | None:
             "final_lo": lo, "final_hi": hi, "final_n": len(diffs)}
 
 
-# The field's standard peer (reward learning over state features), one per signal: every other
-# learner of that signal in the bench is paired with it.
-PEERS = {"stop": "reward-stop", "preference": "reward-preference"}
-
-
-def _signal_of(method: str) -> str | None:
-    from activeintent.learners.registry import get_method
-
-    try:
-        return get_method(method).signal
-    except Exception:  # noqa: BLE001 - a plug-in method not loaded here: its name's last word
-        tail = method.rsplit("-", 1)[-1]
-        return tail if tail in PEERS else None
+def peer_of(signal: str | None) -> str | None:
+    """The field's standard peer for a signal: the first registered method of family "peer" that
+    takes it (reward learning over state features); plug-in variants register after it."""
+    return next((n for n in METHODS.names() if (m := _method(n)) and m.family == "peer" and m.signal == signal), None)
 
 
 def peer_pairs(methods: list[str]) -> list[tuple[str, str]]:
     """(learner, the reward peer of its signal) for every learner of the bench that has one."""
     out = []
     for m in methods:
-        peer = PEERS.get(_signal_of(m) or "")
-        if peer in methods and m != peer and m not in BASELINES and not m.startswith(peer):
+        peer = peer_of(getattr(_method(m), "signal", None))
+        if peer in methods and m != peer and not is_baseline(m) and not m.startswith(peer):
             out.append((m, peer))
     return out
 
 
 def best_baseline(records: list[dict], methods: list[str]) -> str | None:
     """The baseline of this bench with the highest mean success@K (the bar a learner must clear)."""
-    scores = {m: float(np.mean(v)) for m in methods if m in BASELINES
+    scores = {m: float(np.mean(v)) for m in methods if is_baseline(m)
               and (v := [r["success"] for r in records if r["method"] == m and _ok(r)])}
-    return max(scores, key=lambda m: (scores[m], -BASELINES.index(m))) if scores else None
+    return max(scores, key=lambda m: (scores[m], -methods.index(m))) if scores else None
 
 
 def paired_section(records: list[dict], methods: list[str]) -> list[str]:
     """The fixed pairs (EIG against random questions, decide and hybrid against lang) and every other
     method against the best baseline, on the same trials."""
     best = best_baseline(records, methods)
-    pairs = [(a, b) for a, b in PAIRED if a in methods and b in methods]
+    pairs = fixed_pairs(methods)
     peers = [pair for pair in peer_pairs(methods) if pair not in pairs]
     pairs += peers
     if best is not None:
-        pairs += [(m, best) for m in methods if m not in BASELINES and (m, best) not in pairs]
+        pairs += [(m, best) for m in methods if not is_baseline(m) and (m, best) not in pairs]
     rows = [d for a, b in pairs if (d := paired_comparison(records, a, b))]
     if not rows:
         return []
@@ -320,7 +312,7 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
             excl = np.mean([r.get("test_excluded", 0) for r in ran]) if ran else 0
             phys = [r for r in ok if r.get("physics_disagreements") is not None]
             dis = f"{sum(r['physics_disagreements'] for r in phys)} / {len(phys)} ep." if phys else "–"
-            label = f"*{m}* (baseline)" if m in BASELINES else m
+            label = f"*{m}* (baseline)" if is_baseline(m) else m
             errors = sum(1 for r in every if r.get("error"))  # unscored: no test scene could show the intention
             if m in PAPER_TABLE1 and ok:
                 label += " [" + "/".join(sorted({str(r.get("variant") or "structured") for r in ok})) + "]"
@@ -355,8 +347,6 @@ def write_report(records: list[dict], methods: list[str], intentions: list[str],
 
 def set_aside_lines(out: Path) -> list[str]:
     """How many lines of results.jsonl were set aside into rejected.jsonl, and why (none: nothing)."""
-    from activeintent.results import REJECT_KINDS, rejected_counts
-
     counts = rejected_counts(out)
     if not counts:
         return []
@@ -371,7 +361,6 @@ def _oracle_row(oracle: dict[str, dict] | None, suite: str, names: list[str], wi
     if oracle is None:
         return ["| *oracle* (best goal of the goal language) | " + " | ".join("–" for _ in names)
                 + " | not measured (`bench --no-oracle`) | | | | | | |"]
-    from activeintent.suites import is_held_out
 
     got = [oracle[i]["success"] for i in names if i in oracle]
     n = oracle[names[0]]["test_scenes"] if names and names[0] in oracle else 0
@@ -463,8 +452,8 @@ def panel_groups(methods: list[str]) -> list[list[str]]:
     learner is read against), the other methods split over as few panels as needed."""
     if len(methods) <= PANEL_METHODS:
         return [list(methods)]
-    base = [m for m in methods if m in BASELINES]
-    rest = [m for m in methods if m not in BASELINES]
+    base = [m for m in methods if is_baseline(m)]
+    rest = [m for m in methods if not is_baseline(m)]
     room = PANEL_METHODS - len(base)
     if room < 1 or not rest:  # too many baselines to repeat: plain chunks
         return [methods[i:i + PANEL_METHODS] for i in range(0, len(methods), PANEL_METHODS)]
@@ -520,7 +509,7 @@ def plot_success_vs_signals(records: list[dict], methods: list[str], budget: int
                 continue
             ks, mean, lo, hi = _curve_band(curves, budget)
             colour = method_colour(m)
-            ax.plot(ks, mean, "--" if m in BASELINES else "-", marker="o", ms=3, color=colour,
+            ax.plot(ks, mean, "--" if is_baseline(m) else "-", marker="o", ms=3, color=colour,
                     label=f"{m} (n={len(curves)})")
             ax.fill_between(ks, lo, hi, color=colour, alpha=0.12, linewidth=0)
         handles, names = ax.get_legend_handles_labels()

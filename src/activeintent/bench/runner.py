@@ -24,7 +24,9 @@ from concurrent.futures.process import BrokenProcessPool
 from multiprocessing import get_context
 from pathlib import Path
 
+from activeintent.bench.backends import execute_ray
 from activeintent.bench.checks import Plan
+from activeintent.bench.verify import differences
 from activeintent.bench.work import (
     BenchConfig,
     WorkItem,
@@ -99,8 +101,6 @@ def _settle_duplicate(path: Path, again: dict, cands: list[Candidate]) -> tuple[
     (by bench-verify's comparison) stays, the others are set aside; none equal, all are, and
     the re-run's record takes their place. Set aside first, then the file rewritten at once: a
     kill in between leaves the duplicates in place, to be settled by the next resume."""
-    from activeintent.bench.verify import differences
-
     plain = json.loads(dumps(again))  # as it would be read back
     winner = next((c for c in cands if not again.get("error") and not differences(c.record, plain)), None)
     losers = [c for c in cands if c is not winner]
@@ -157,8 +157,6 @@ def _check_same_settings(options: BenchConfig, path: Path) -> None:
 
 def _execute(todo: list[WorkItem], options: BenchConfig, out: Path) -> Iterator[dict]:
     if options.backend == "ray":
-        from activeintent.bench.backends import execute_ray
-
         yield from execute_ray(todo, options, out)
         return
     args = (options.run, options.seed, str(out), options.keep_episodes)

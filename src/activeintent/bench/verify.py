@@ -14,7 +14,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from activeintent.bench.checks import Plan
+from activeintent.bench.work import WorkItem, read_bench_config, run_item
 from activeintent.protocol import FORMAT_VERSION
+from activeintent.results import load_results, read_results
 from activeintent.spec import OPTIONS_ADDED
 
 NOT_VERIFIED = "NOT-VERIFIED.md"  # a folder's own word on why it cannot be re-run
@@ -80,10 +83,6 @@ def untrusted(folder: Path) -> list:
     """Every line of the folder's results.jsonl that its plan (bench.json) or its own fields do
     not support (bench/checks.py), and every episode recorded more than once: cheap, no episode
     is run. Empty when every record belongs to the folder."""
-    from activeintent.bench.checks import Plan
-    from activeintent.bench.work import read_bench_config
-    from activeintent.results import load_results
-
     plan = Plan(read_bench_config(folder / "bench.json"))
     return load_results(folder / "results.jsonl", plan).set_aside_duplicates().rejected
 
@@ -91,10 +90,6 @@ def untrusted(folder: Path) -> list:
 def verify(folder: Path, sample: int, methods: list[str] | None = None) -> list[dict]:
     """Differences between recorded and re-run episodes (empty when they agree). Only records
     that pass the folder's checks (:func:`untrusted`) are sampled."""
-    from activeintent.bench.checks import Plan
-    from activeintent.bench.work import WorkItem, read_bench_config, run_item
-    from activeintent.results import read_results
-
     note = folder / NOT_VERIFIED
     if note.is_file():
         raise StaleFolder(f"{folder} cannot be verified: {note.read_text().strip().splitlines()[0].lstrip('# ')}")
@@ -125,6 +120,4 @@ def committed_folders(root: Path) -> list[Path]:
 
 
 def methods_of(folder: Path) -> list[str]:
-    from activeintent.results import read_results
-
     return sorted({r["method"] for r in read_results(folder / "results.jsonl") if not r.get("error")})

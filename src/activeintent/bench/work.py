@@ -10,6 +10,7 @@ from pathlib import Path
 from pydantic import BaseModel, Field
 
 from activeintent.protocol import trial_seeds
+from activeintent.runner import build_episode, with_method_defaults
 from activeintent.spec import OPTIONS, OPTIONS_ADDED, RunSpec
 
 
@@ -109,13 +110,10 @@ def run_item(item: WorkItem, options: RunSpec, bench_seed: int, out: str, keep: 
     run = options.with_options(method=item.method, intention=None if user_defined else item.intention,
                                intention_file=item.intention if user_defined else None,
                                seed=seed, test_seed=test_seed)
-    from activeintent.runner import with_method_defaults
 
     run = with_method_defaults(run)  # the prior the method ran with, in every line
     base = {"method": item.method, "intention": item.intention, "trial": item.trial, **protocol_fields(run)}
     try:
-        from activeintent.runner import build_episode
-
         episode = build_episode(run, Path(out) / "episodes" / item.slug if keep else None)
         try:
             result = episode.run()

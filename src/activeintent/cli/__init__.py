@@ -8,6 +8,8 @@ import importlib
 
 import typer
 
+from activeintent.cli.options import check_only
+
 app = typer.Typer(
     name="activeintent",
     help="Large models as active learners of a user's intention from sparse signals.",
@@ -44,8 +46,6 @@ _MEASURING = {"coverage", "sim-demo", "sim-bench", "model-bench", "act-bench", "
 def _checked(callback):
     @functools.wraps(callback)
     def wrapper(*args, **kwargs):
-        from activeintent.cli.options import check_only
-
         if check_only():
             return None
         return callback(*args, **kwargs)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import typer
 
+from activeintent.act.isolation import SandboxUnavailable
 from activeintent.act.overhead import run_bench
 
 
@@ -16,8 +17,6 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Executor overhead without the model call: parsing, plan validation, sandbox cost."""
         import json
-
-        from activeintent.act.isolation import SandboxUnavailable
 
         try:
             report = run_bench(programs, seed)

@@ -7,8 +7,20 @@ from typing import Annotated
 
 import typer
 
+from activeintent.bench.backends import check_backend
+from activeintent.bench.coverage import EXPRESSIBLE, agreement, coverage_table, oracle_of
+from activeintent.bench.report import plot_success_vs_signals, write_report
+from activeintent.bench.runner import run_bench
+from activeintent.bench.work import BenchConfig, protocol_fields
 from activeintent.cli import options as opt
 from activeintent.cli.options import D
+from activeintent.goals.language import parse_goal, speaking
+from activeintent.goals.prior import load_prior
+from activeintent.progress_lines import Eta, print_line
+from activeintent.registry import load_plugin
+from activeintent.runner import check_spec
+from activeintent.suites import is_held_out, resolve, suite_of
+from activeintent.suites import suite as suite_names
 
 
 def register(app: typer.Typer) -> None:
@@ -79,14 +91,6 @@ def bench(
     report.md and success_vs_signals.png."""
     from rich.console import Console
 
-    from activeintent.bench.backends import check_backend
-    from activeintent.bench.report import plot_success_vs_signals, write_report
-    from activeintent.bench.runner import run_bench
-    from activeintent.bench.work import BenchConfig, protocol_fields
-    from activeintent.runner import check_spec
-    from activeintent.suites import resolve
-    from activeintent.suites import suite as suite_names
-
     console = Console()
     try:
         check_backend(backend)
@@ -135,10 +139,6 @@ def bench(
     all_intentions = intention_list + list(intention_file or [])
     ceiling = None
     if oracle:
-        from activeintent.bench.coverage import oracle_of
-        from activeintent.goals.language import speaking
-        from activeintent.progress_lines import print_line
-
         with speaking(run.learner.language):  # the ceiling of the language the learners spoke
             ceiling = oracle_of({i: resolve(None, i) if ".py:" in i else resolve(i) for i in all_intentions},
                                 progress=lambda text: print_line(console, text))
@@ -164,8 +164,6 @@ class _RejectedLines:
     def __call__(self, rejected: list, where: Path) -> None:
         from rich.markup import escape
 
-        from activeintent.progress_lines import print_line
-
         print_line(self.console, f"[yellow]warning:[/yellow] {len(rejected)} line(s) of results.jsonl not trusted, "
                    f"moved to {escape(str(where))} (their episodes run again):")
         for r in rejected[:self.SHOWN]:
@@ -183,8 +181,6 @@ class _ProgressLines:
 
     def __call__(self, record: dict, finished: int, total: int) -> None:
         from rich.markup import escape
-
-        from activeintent.progress_lines import Eta, print_line
 
         if self.eta is None:  # the first call: episodes already in the folder
             self.eta = Eta(total, done_before=finished)
@@ -209,8 +205,6 @@ def _run_with_progress_bar(console, options, out: Path, names: dict[str, str]) -
         TimeElapsedColumn,
         TimeRemainingColumn,
     )
-
-    from activeintent.bench.runner import run_bench
 
     progress = Progress(TextColumn("[bold]bench"), BarColumn(), MofNCompleteColumn(), TextColumn("episodes"),
                         TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(), TextColumn("{task.description}"),
@@ -257,15 +251,8 @@ def coverage(
     from rich.markup import escape
     from rich.table import Table
 
-    from activeintent.bench.coverage import EXPRESSIBLE, coverage_table
-    from activeintent.progress_lines import print_line
-    from activeintent.suites import is_held_out, resolve, suite_of
-    from activeintent.suites import suite as suite_names
-
     console = Console()
     try:
-        from activeintent.registry import load_plugin
-
         for path in plugin or []:
             load_plugin(path)
         names = _split(intentions) or [i for s in _split(suite) for i in suite_names(s)]
@@ -274,7 +261,6 @@ def coverage(
             raise ValueError("nothing to measure: give --suite, --intentions or --intention-file")
         if prior == "uniform":
             raise ValueError("--prior uniform gives no bits to report: take length, fitted or file:PATH")
-        from activeintent.goals.prior import load_prior
 
         load_prior(prior)  # a missing or malformed file is refused before the search
     except (ValueError, FileNotFoundError) as err:
@@ -282,9 +268,6 @@ def coverage(
         raise typer.Exit(2) from None
     groups = [suite_of(n) for n in names] + ["file"] * len(intention_file or [])
     if goal is not None:
-        from activeintent.bench.coverage import agreement
-        from activeintent.goals.language import parse_goal
-
         if any(is_held_out(g) for g in groups) and not after_freeze:
             console.print("[red]error:[/red] held-out intentions are read only after a freeze (--after-freeze)")
             raise typer.Exit(2)

@@ -8,6 +8,14 @@ from typing import Annotated
 import numpy as np
 import typer
 
+from activeintent.bench.coverage import explain_intention
+from activeintent.intentions.registry import PAPER_INTENTIONS, IntentionError
+from activeintent.learners.bayes.hypotheses import enumerate_hypotheses, hypothesis_space, log_prior
+from activeintent.learners.lang.explain import explain as explain_sentence
+from activeintent.learners.lang.explain import language_summary
+from activeintent.runner import RunSpec, build_episode
+from activeintent.suites import is_held_out, resolve, suite_of
+
 
 def register(app: typer.Typer) -> None:
     @app.command("hypotheses")
@@ -24,17 +32,9 @@ def register(app: typer.Typer) -> None:
         import numpy as np
 
         if explain is not None or language:
-            from activeintent.learners.lang.explain import language_summary
-
             out = _explained(explain) if explain is not None else language_summary(examples)
             typer.echo(json.dumps(out, indent=2, ensure_ascii=False) if as_json else _lang_text(out))
             return
-
-        from activeintent.learners.bayes.hypotheses import (
-            enumerate_hypotheses,
-            hypothesis_space,
-            log_prior,
-        )
 
         hyps = hypothesis_space()
         prior = np.exp(log_prior(hyps))
@@ -75,9 +75,6 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Learner time per signal of bayes-preference and bayes-stop (target ≤ 2 s median),
         measured in the one episode loop (symbolic env, human-preset users, no model)."""
-        from activeintent.intentions.registry import PAPER_INTENTIONS
-        from activeintent.runner import RunSpec, build_episode
-
         result: dict = {}
         for method in ("bayes-preference", "bayes-stop"):
             per_signal = []
@@ -99,11 +96,6 @@ def register(app: typer.Typer) -> None:
 
 def _explained(text: str) -> dict:
     """By behaviour for an intention's name or path.py:NAME, by words for a sentence."""
-    from activeintent.bench.coverage import explain_intention
-    from activeintent.intentions.registry import IntentionError
-    from activeintent.learners.lang.explain import explain as explain_sentence
-    from activeintent.suites import is_held_out, resolve, suite_of
-
     name = text.strip()
     looks_like_name = ".py:" in name or (" " not in name and len(name) < 80)
     if not looks_like_name:

@@ -6,6 +6,13 @@ from typing import Annotated
 
 import typer
 
+from activeintent.intentions.registry import (
+    PAPER_INTENTIONS,
+    IntentionError,
+    all_intentions,
+    load_intention_file,
+)
+
 
 def register(app: typer.Typer) -> None:
     app.command(name="intentions")(intentions)
@@ -20,13 +27,6 @@ def intentions(
     """List the intentions a simulated user can hold (name, one sentence, from the paper or not)."""
     from rich.console import Console
     from rich.table import Table
-
-    from activeintent.intentions.registry import (
-        PAPER_INTENTIONS,
-        IntentionError,
-        all_intentions,
-        load_intention_file,
-    )
 
     console = Console()
     rows = [(i.name, i.description, "paper" if i.name in PAPER_INTENTIONS else "") for i in all_intentions()]

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import typer
 
+from activeintent.learners.registry import get_method, method_names
+
 
 def register(app: typer.Typer) -> None:
     app.command(name="methods")(methods)
@@ -13,8 +15,6 @@ def methods() -> None:
     """List the methods (learners) with their signal and whether they need a model."""
     from rich.console import Console
     from rich.table import Table
-
-    from activeintent.learners.registry import get_method, method_names
 
     table = Table(title="methods")
     for col in ("method", "family", "signal", "needs a model", "what it does"):

@@ -7,6 +7,10 @@ from typing import Annotated
 
 import typer
 
+from activeintent.llm.embedded import EmbeddedConfig
+from activeintent.llm.registry import parse_spec
+from activeintent.llm.speed import run_model_bench
+
 
 def register(app: typer.Typer) -> None:
     @app.command("model-bench")
@@ -25,10 +29,6 @@ def register(app: typer.Typer) -> None:
         as_json: Annotated[bool, typer.Option("--json", help="print one JSON object")] = False,
     ) -> None:
         """Load time, tokens/s (free text and structured), mean latency of a learner-sized call."""
-        from activeintent.llm.embedded import EmbeddedConfig
-        from activeintent.llm.registry import parse_spec
-        from activeintent.llm.speed import run_model_bench
-
         try:
             parse_spec(model)
         except ValueError as exc:

@@ -11,6 +11,7 @@ from typing import Annotated
 import typer
 
 from activeintent.spec import RunSpec
+from activeintent.web.basics import parse_video_size
 
 D = SimpleNamespace(**RunSpec().options())  # the defaults, by option name
 
@@ -60,8 +61,6 @@ def run_spec(**values) -> RunSpec:
 
 
 def _video_size(text: str) -> tuple[int, int]:
-    from activeintent.web.basics import parse_video_size
-
     try:
         return parse_video_size(text)
     except ValueError as err:

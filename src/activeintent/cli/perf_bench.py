@@ -15,6 +15,9 @@ from typing import Annotated
 
 import typer
 
+from activeintent.progress_lines import Eta, print_line
+from activeintent.runner import RunSpec, build_episode
+
 
 def register(app: typer.Typer) -> None:
     app.command(name="perf-bench")(perf_bench)
@@ -31,8 +34,6 @@ def perf_bench(
     """Time per phase and per episode of fixed `run`-like episodes (no video, no model), the
     learner's time per signal (choosing the query, reading the answer; scoring excluded), and
     the time of an episode outside that per-signal work (scoring, env, user, records)."""
-    from activeintent.runner import RunSpec, build_episode
-
     class RoundTimes:
         def __init__(self) -> None:
             self.learner_s: list[float] = []
@@ -41,8 +42,6 @@ def perf_bench(
             self.learner_s.append(log.timing.get("learner_s", 0.0))
 
     from rich.console import Console
-
-    from activeintent.progress_lines import Eta, print_line
 
     names = [n.strip() for n in intentions.split(",") if n.strip()]
     env_names = [e.strip() for e in envs.split(",") if e.strip()]

@@ -9,6 +9,8 @@ from typing import Annotated
 
 import typer
 
+from activeintent.goals.prior import PriorError, choose_alpha, fit, nested_cv, read_corpus
+
 
 def register(app: typer.Typer) -> None:
     prior = typer.Typer(help="Priors over the goal language (lang-*): fit one to your population's requests.",
@@ -27,8 +29,6 @@ def prior_fit(
     """Count each choice of the grammar in the corpus's goals, choose the Dirichlet smoothing
     strength by cross-validation, write the prior, and report held-out bits per request against
     the length prior (nested cross-validation)."""
-    from activeintent.goals.prior import PriorError, choose_alpha, fit, nested_cv, read_corpus
-
     try:
         goals, digest = read_corpus(corpus)
     except PriorError as err:

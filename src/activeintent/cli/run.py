@@ -6,8 +6,15 @@ from pathlib import Path
 
 import typer
 
+from activeintent.act.isolation import allow_unsafe_no_isolation
 from activeintent.cli import options as opt
 from activeintent.cli.options import D
+from activeintent.learners.registry import get_method
+from activeintent.llm.base import ModelError
+from activeintent.progress_lines import Eta, print_line
+from activeintent.runner import DEFAULT_INTENTION, build_episode, check_spec
+from activeintent.signals import answer_kind_from_dump
+from activeintent.suites import resolve
 
 
 def register(app: typer.Typer) -> None:
@@ -46,14 +53,10 @@ class LiveTable:
         self._held: dict | None = None  # the last round, until the estimate after it is known
 
     def started(self, episode) -> None:
-        from activeintent.progress_lines import Eta
-
         self._learner = episode.learner
         self.eta = Eta(self.budget)
 
     def _say(self, text: str) -> None:
-        from activeintent.progress_lines import print_line
-
         print_line(self.console, text)
 
     def _report_model_errors(self) -> None:
@@ -94,8 +97,6 @@ class LiveTable:
 
     def answered(self, log) -> None:
         from rich.markup import escape
-
-        from activeintent.signals import answer_kind_from_dump
 
         # this round's z was estimated after the previous round's answer: that row is complete
         self._write(log.z)
@@ -162,14 +163,8 @@ def run(
     from rich.live import Live
     from rich.markup import escape
 
-    from activeintent.llm.base import ModelError
-    from activeintent.progress_lines import print_line
-    from activeintent.runner import DEFAULT_INTENTION, build_episode
-
     console = plain_console()
     if unsafe_no_isolation:
-        from activeintent.act.isolation import allow_unsafe_no_isolation
-
         allow_unsafe_no_isolation()
     try:
         spec = opt.run_spec(
@@ -194,9 +189,6 @@ def run(
     live = LiveTable(console, method, budget, seed, llm=llm, lines=not console.is_terminal)
     if opt.check_only():
         try:
-            from activeintent.runner import check_spec
-            from activeintent.suites import resolve
-
             check_spec(spec)
             resolve(intention or (None if intention_file else DEFAULT_INTENTION), intention_file)
         except (ValueError, FileNotFoundError) as err:
@@ -250,8 +242,6 @@ def run(
 
 def method_asks_a_model(method: str) -> bool:
     """Whether the method's learner needs a language model (an unknown name: False, refused later)."""
-    from activeintent.learners.registry import get_method
-
     try:
         return bool(get_method(method).needs_llm)
     except (KeyError, ValueError):

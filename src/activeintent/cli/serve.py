@@ -11,7 +11,13 @@ import typer
 
 from activeintent.cli import options as opt
 from activeintent.cli.options import D
+from activeintent.intentions.registry import IntentionError
+from activeintent.learners.registry import get_method
+from activeintent.runner import check_spec
+from activeintent.suites import resolve as resolve_intention
 from activeintent.web.basics import VIDEO_SIZE_TEXT
+from activeintent.web.export import collect_sessions, corpus_rows, write_table
+from activeintent.web.study import StudyFileError, load_study
 
 
 class ShowEstimate(StrEnum):
@@ -67,15 +73,11 @@ def serve(
     """
     from rich.console import Console
 
-    from activeintent.intentions.registry import IntentionError
-    from activeintent.learners.registry import get_method
-    from activeintent.runner import check_spec
-    from activeintent.suites import resolve as resolve_intention
+    # lazy: FastAPI, Starlette and uvicorn load only for serve (~0.5 s)
     from activeintent.web import transport
     from activeintent.web.limits import Limits
     from activeintent.web.server import create_app, page_signal, runner_builder
     from activeintent.web.session import StudyConfig
-    from activeintent.web.study import StudyFileError, load_study
 
     size = tuple(video_size)  # parsed by the option
     extra = dict(prior=prior, scenes=scenes, vlm=vlm, base_url=base_url, cache=cache,
@@ -181,8 +183,6 @@ def study_export(
     timings, success (assigned-rule sessions only) and the questionnaire."""
     from rich.console import Console
 
-    from activeintent.web.export import collect_sessions, write_table
-
     if not out_dir.is_dir():
         raise typer.BadParameter(f"{out_dir} is not a folder", param_hint="OUT_DIR")
     if to.suffix.lower() not in (".csv", ".jsonl"):
@@ -192,8 +192,6 @@ def study_export(
     if corpus is not None:
         import json
         import os
-
-        from activeintent.web.export import corpus_rows
 
         rows = corpus_rows(sessions)
         corpus.parent.mkdir(parents=True, exist_ok=True)

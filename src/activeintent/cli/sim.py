@@ -7,12 +7,12 @@ from typing import Annotated
 
 import typer
 
+from activeintent.world import PutAt, PutIn, PutNextTo, PutOn
+
 DEMO_SCENE = ("red block", "green block", "yellow block", "blue bowl", "purple bowl")
 
 
 def _demo_plan() -> list:
-    from activeintent.world import PutAt, PutIn, PutNextTo, PutOn
-
     return [
         PutIn(block="red block", bowl="blue bowl"),
         PutOn(block="green block", target="yellow block"),
@@ -33,6 +33,7 @@ def register(app: typer.Typer) -> None:
         from rich.console import Console
         from rich.progress import Progress
 
+        # lazy: PyBullet loads only for sim-demo and sim-bench
         from activeintent.sim.env import PyBulletEnv
         from activeintent.sim.video import export_video
         from activeintent.world import describe_plan, describe_state
@@ -74,6 +75,7 @@ def register(app: typer.Typer) -> None:
 
         import pybullet as p
 
+        # lazy: PyBullet loads only for sim-demo and sim-bench
         from activeintent.sim.env import PyBulletEnv
         from activeintent.sim.render import render_frame
         from activeintent.sim.video import export_video

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Protocol, runtime_checkable
 
+from activeintent.envs.symbolic import SymbolicEnv
 from activeintent.registry import Registry
 from activeintent.world import Scene, Skill, WorldState
 from activeintent.world.trajectory import Trajectory
@@ -30,13 +31,12 @@ ENVS: Registry[Env] = Registry("env")
 
 @ENVS.register("symbolic", help="the symbolic world model: fast, no physics, no images")
 def _symbolic() -> Env:
-    from activeintent.envs.symbolic import SymbolicEnv
-
     return SymbolicEnv()
 
 
 @ENVS.register("pybullet", help="PyBullet physics with a Panda arm; renders frames")
 def _pybullet() -> Env:
+    # lazy: PyBullet loads (and prints its banner) only when this env is chosen
     from activeintent.sim.env import PyBulletEnv
 
     return PyBulletEnv()

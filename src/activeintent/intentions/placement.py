@@ -11,7 +11,16 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from activeintent.world import BOUNDS, PutAt, Relations, Skill, WorldState, apply_plan, relations
+from activeintent.world import (
+    BOUNDS,
+    WARM_COLORS,
+    PutAt,
+    Relations,
+    Skill,
+    WorldState,
+    apply_plan,
+    relations,
+)
 from activeintent.world.predict import SkillFailure, apply_skill, target_position
 from activeintent.world.scene import ROW_PITCH as ROW_PITCH  # the suites read it here
 from activeintent.world.scene import color_of
@@ -65,8 +74,6 @@ def top_first(state: WorldState, blocks: Iterable[str]) -> list[str]:
 
 
 def is_warm(name: str) -> bool:
-    from activeintent.world import WARM_COLORS
-
     return color_of(name) in WARM_COLORS
 
 

@@ -16,6 +16,7 @@ from activeintent.goals.language import CORNER_CELL, ColourClass, Corners, InReg
 from activeintent.intentions.blockwise import BlockwiseIntention
 from activeintent.intentions.placement import TABLE_INNER, free_spot, grid, nearest_first
 from activeintent.world import (
+    COLOR_NAMES,
     COOL_COLORS,
     WARM_COLORS,
     Relations,
@@ -39,8 +40,6 @@ def _cell(corner: str) -> tuple[tuple[float, float], tuple[float, float]]:
 
 
 def _scene(rng: np.random.Generator, n_blocks: int, n_bowls: int, block_colors: list[str] | None = None) -> Scene:
-    from activeintent.world import COLOR_NAMES
-
     blocks = block_colors or [str(c) for c in rng.choice(COLOR_NAMES, size=n_blocks, replace=False)]
     bowls = [str(c) for c in rng.choice(COLOR_NAMES, size=n_bowls, replace=False)]
     return Scene(objects=[f"{c} block" for c in blocks] + [f"{c} bowl" for c in bowls])

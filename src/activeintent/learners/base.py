@@ -114,6 +114,8 @@ class Method:
     help: str = ""
     family: str = "ours"  # paper | ours | baseline
     goal_language: bool = False  # its hypotheses are goals of the language: --prior fitted / file: apply
+    colour: str | None = None  # its colour in every report figure (None: a spare colour by a hash of its name)
+    compared_with: str | None = None  # reports pair it with this method on the same trials (e.g. its random-question twin)
 
     @property
     def default_prior(self) -> str:

@@ -9,20 +9,24 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from activeintent.learners.base import Learner, LearnerContext, Method
+from activeintent.learners.bayes.learner import (
+    BayesConfig,
+    BayesLearner,
+    RandomQueryLearner,
+    ZeroSignalLearner,
+)
+from activeintent.learners.lang.learner import lang_method, lang_zero_signal
+from activeintent.learners.paper import faithful as f
+from activeintent.learners.paper import structured as p
+from activeintent.learners.reward.learner import RewardLearner
 from activeintent.registry import Registry, UnknownName
+from activeintent.signals import SIGNALS
 
 METHODS: Registry[Method] = Registry("method")
 
 
 def _bayes(signal: str, kind: str = "eig") -> Callable[[LearnerContext], Learner]:
     def build(ctx: LearnerContext) -> Learner:
-        from activeintent.learners.bayes.learner import (
-            BayesConfig,
-            BayesLearner,
-            RandomQueryLearner,
-            ZeroSignalLearner,
-        )
-
         cls = {"eig": BayesLearner, "random": RandomQueryLearner, "zero": ZeroSignalLearner}[kind]
         config = BayesConfig(prior=ctx.config.prior, scenes=ctx.config.scenes)  # type: ignore[arg-type]
         return cls(signal, rng=ctx.learner_seed, llm=ctx.llm, config=config)
@@ -34,8 +38,6 @@ def _paper(kind: str) -> Callable[[LearnerContext], Learner]:
     def build(ctx: LearnerContext) -> Learner:
         # variant and retriever were validated with the spec (spec.LearnerConfig)
         if ctx.config.variant == "faithful":
-            from activeintent.learners.paper import faithful as f
-
             cfg = f.FaithfulConfig(design_scenes=ctx.config.design_scenes, epsilon=ctx.config.epsilon,
                                    early_threshold=ctx.config.early_threshold, seed=ctx.learner_seed)
             if kind == "preference":
@@ -43,7 +45,6 @@ def _paper(kind: str) -> Callable[[LearnerContext], Learner]:
             if kind == "mllm":
                 return f.FaithfulMllmLearner(ctx.vlm or ctx.llm, cfg)  # type: ignore[arg-type]
             return f.FaithfulMllmLlmLearner(ctx.llm, ctx.vlm, retriever=ctx.config.retriever, config=cfg)  # type: ignore[arg-type]
-        from activeintent.learners.paper import structured as p
 
         config = p.PaperLearnerConfig(design_scenes=ctx.config.design_scenes, epsilon=ctx.config.epsilon,
                                       early_threshold=ctx.config.early_threshold)
@@ -57,44 +58,31 @@ def _paper(kind: str) -> Callable[[LearnerContext], Learner]:
 
 
 METHODS.register("preference", lambda: Method("preference", True, _paper("preference"),
-                 "the paper's eq. 1–2: the LLM estimates z, then two goals y^a, y^b", "paper"))
+                 "the paper's eq. 1–2: the LLM estimates z, then two goals y^a, y^b", "paper", colour="#9467bd"))
 METHODS.register("mllm", lambda: Method("stop", True, _paper("mllm"),
-                 "the paper: one multimodal model reads prompt(h) (eq. 3) and gives z, y", "paper"))
+                 "the paper: one multimodal model reads prompt(h) (eq. 3) and gives z, y", "paper", colour="#8c564b"))
 METHODS.register("mllm-llm", lambda: Method("stop", True, _paper("mllm-llm"),
-                 "the paper's best: a retriever gives r (eq. 4), the LLM gives z, y (eq. 5–6)", "paper"))
+                 "the paper's best: a retriever gives r (eq. 4), the LLM gives z, y (eq. 5–6)", "paper", colour="#e377c2"))
 METHODS.register("bayes-preference", lambda: Method("preference", False, _bayes("preference"),
-                 "ours: belief over z, A/B queries by expected information gain"))
+                 "ours: belief over z, A/B queries by expected information gain", colour="#ff7f0e",
+                 compared_with="random-query-preference"))
 METHODS.register("bayes-stop", lambda: Method("stop", False, _bayes("stop"),
-                 "ours: belief over z, stop queries by expected information gain"))
+                 "ours: belief over z, stop queries by expected information gain", colour="#1f77b4",
+                 compared_with="random-query"))
 METHODS.register("zero-signal", lambda: Method("stop", False, _bayes("stop", "zero"),
-                 "baseline: the prior's best guess, asks nothing", "baseline"))
+                 "baseline: the prior's best guess, asks nothing", "baseline", colour="#7f7f7f"))
 METHODS.register("random-query", lambda: Method("stop", False, _bayes("stop", "random"),
-                 "baseline: bayes-stop's belief update with random stop queries", "baseline"))
+                 "baseline: bayes-stop's belief update with random stop queries", "baseline", colour="#aec7e8"))
 METHODS.register("random-query-preference", lambda: Method("preference", False, _bayes("preference", "random"),
-                 "baseline: bayes-preference's belief update with random A/B queries", "baseline"))
+                 "baseline: bayes-preference's belief update with random A/B queries", "baseline",
+                 colour="#ffbb78"))
+METHODS.register("lang-stop", lambda: lang_method("stop"))
+METHODS.register("lang-preference", lambda: lang_method("preference"))
+METHODS.register("lang-zero-signal", lang_zero_signal)
 
-def _lang(signal: str) -> Method:  # the builder lives in learners/lang
-    from activeintent.learners.lang.learner import lang_method
-
-    return lang_method(signal)
-
-
-METHODS.register("lang-stop", lambda: _lang("stop"))
-METHODS.register("lang-preference", lambda: _lang("preference"))
-
-
-def _lang_zero() -> Method:
-    from activeintent.learners.lang.learner import lang_zero_signal
-
-    return lang_zero_signal()
-
-
-METHODS.register("lang-zero-signal", _lang_zero)
 
 def _reward(signal: str) -> Callable[[LearnerContext], Learner]:
     def build(ctx: LearnerContext) -> Learner:
-        from activeintent.learners.reward.learner import RewardLearner
-
         return RewardLearner(signal, rng=ctx.learner_seed)
 
     return build
@@ -103,7 +91,8 @@ def _reward(signal: str) -> Callable[[LearnerContext], Learner]:
 for _signal in ("preference", "stop"):
     METHODS.register(f"reward-{_signal}", lambda s=_signal: Method(s, False, _reward(s), (
         f"peer: APReL-style reward learning, w·φ(state) over 307 relation features, {s} queries by "
-        "mutual information (candidates include the Bayesian planner on its prior)"), "peer"))
+        "mutual information (candidates include the Bayesian planner on its prior)"), "peer",
+        colour={"preference": "#bcbd22", "stop": "#17becf"}[s]))
 
 PAPER_METHODS = ("preference", "mllm", "mllm-llm")
 BASELINES = ("zero-signal", "lang-zero-signal", "random-query", "random-query-preference")
@@ -112,8 +101,6 @@ BASELINES = ("zero-signal", "lang-zero-signal", "random-query", "random-query-pr
 def _derived() -> dict[str, str]:
     """``bayes-<signal>`` for every registered signal without a method of that name (derived
     when asked, never registered: plug-in signals added later get theirs too)."""
-    from activeintent.signals import SIGNALS
-
     return {f"bayes-{s}": s for s in SIGNALS.names() if f"bayes-{s}" not in METHODS}
 
 

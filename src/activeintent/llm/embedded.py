@@ -25,6 +25,7 @@ from activeintent.llm.base import (
     ModelUnavailableError,
     StructuredOutputError,
 )
+from activeintent.llm.grammar_greedy import GrammarFirstGreedy, GrammarFirstSampling
 
 # ggml waits at an OpenMP barrier after every operation. libgomp's default spin (300,000 turns)
 # holds a core another process may need (a learner-sized call took 4.4 s with one core busy);
@@ -183,8 +184,6 @@ def _offer_grammar_first(llama: Any) -> None:
     """Let ``llama`` decode a structured answer with GrammarFirstGreedy (temperature 0) or
     GrammarFirstSampling (temperature > 0) when the call asks for it (``llama.grammar_first``,
     set per call: backends share one Llama)."""
-    from activeintent.llm.grammar_greedy import GrammarFirstGreedy, GrammarFirstSampling
-
     chain = llama._init_sampler  # llama-cpp-python builds each generation's sampler here
 
     def init_sampler(**kw):

@@ -12,7 +12,7 @@ from activeintent.llm.accounting import Usage
 from activeintent.llm.backend import BackendModel
 from activeintent.llm.base import ChatModel
 from activeintent.llm.cache import ResponseCache, check_mode
-from activeintent.llm.embedded import EmbeddedConfig
+from activeintent.llm.embedded import EmbeddedBackend, EmbeddedConfig
 from activeintent.llm.retry import RetryPolicy
 
 VALID_SPECS = (
@@ -72,6 +72,7 @@ def load_model(
     if parsed.kind == "openai":
         import os
 
+        # lazy: the openai SDK takes ~1.5 s to import; only remote models need it
         from activeintent.llm.openai_compat import DUMMY_API_KEY, OpenAIBackend
 
         # Replaying a recorded cache needs no server and so no key.
@@ -85,8 +86,6 @@ def load_model(
             seed=seed,
         )
     else:
-        from activeintent.llm.embedded import EmbeddedBackend
-
         config = embedded or EmbeddedConfig(seed=seed)
         backend = EmbeddedBackend(parsed.target if parsed.kind == "gguf" else None, config)
     return BackendModel(backend, cache=cache, usage=usage, max_repairs=max_repairs)

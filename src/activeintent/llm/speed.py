@@ -10,9 +10,10 @@ from typing import Any
 from pydantic import BaseModel, Field
 
 from activeintent.llm.accounting import Usage
+from activeintent.llm.backend import ChatRequest
 from activeintent.llm.base import ChatModel, Message
-from activeintent.llm.embedded import EmbeddedConfig
-from activeintent.llm.registry import load_model
+from activeintent.llm.embedded import EmbeddedBackend, EmbeddedConfig
+from activeintent.llm.registry import load_model, parse_spec
 
 
 class BenchGoal(BaseModel):
@@ -90,9 +91,6 @@ def _setting_pair(spec: str, embedded: EmbeddedConfig | None, setting: str, **fi
     """(config, backend with ``setting`` off, backend with it on) of an in-process model
     (``embedded`` or ``gguf:``), ``fixed`` in both; the two share one loaded model (these
     settings are not part of what is loaded)."""
-    from activeintent.llm.embedded import EmbeddedBackend
-    from activeintent.llm.registry import parse_spec
-
     parsed = parse_spec(spec)
     if parsed.kind not in ("embedded", "gguf"):
         raise ValueError(f"{setting} is a setting of the in-process model, not of {spec}")
@@ -127,9 +125,6 @@ def run_prefix_reuse(
     previous prompt (on, the default). Reports both latencies and whether every answer is
     byte-identical.
     """
-    from activeintent.llm.backend import ChatRequest
-    from activeintent.llm.embedded import EmbeddedBackend
-
     config, scratch, reuse = _setting_pair(spec, embedded, "reuse_prefix")
     schema = BenchGoal.model_json_schema()
     requests = [
@@ -172,8 +167,6 @@ def run_grammar_first(
     """An in-process model answers ``prompts`` learner-sized structured prompts with llama.cpp's
     own grammar-then-greedy chain (``grammar_first`` off) and with GrammarFirstGreedy (on, the
     default); reports both latencies and whether every answer is byte-identical."""
-    from activeintent.llm.backend import ChatRequest
-
     config, *pair = _setting_pair(spec, embedded, "grammar_first", reuse_prefix=False)
     backends = dict(zip((False, True), pair, strict=True))
     schema = BenchGoal.model_json_schema()

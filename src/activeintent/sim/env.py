@@ -21,6 +21,7 @@ import pybullet as p
 from pydantic import BaseModel, Field, TypeAdapter, ValidationError, model_validator
 
 from activeintent.sim.assets import create_object, create_table
+from activeintent.sim.render import render_frame
 from activeintent.sim.robot import FINGER_CLOSED, FINGER_OPEN, HOME_EE, SEED_POSES, ArmReplay, Panda
 from activeintent.world.predict import SkillFailure, target_position
 from activeintent.world.scene import BLOCK_SIZE, BOWL_HEIGHT, Scene, SceneError, kind_of, layout
@@ -316,6 +317,4 @@ TabletopEnv = PyBulletEnv  # the name used before envs became plug-ins
 
 
 def _render(traj: Trajectory, t: float, size: tuple[int, int]) -> np.ndarray:
-    from activeintent.sim.render import render_frame  # imported late: render imports world only
-
     return render_frame(traj, t, size=size)

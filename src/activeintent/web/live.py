@@ -17,6 +17,8 @@ from collections.abc import AsyncIterator
 from pathlib import Path
 from typing import Any
 
+from activeintent.sim.video import export_video
+
 CLUSTER_ID = b"\x1f\x43\xb6\x75"  # a Matroska/WebM Cluster element: frames the browser can play
 POLL_S = 0.02
 READ_BYTES = 1 << 16
@@ -37,8 +39,6 @@ class LiveExport:
         self._thread.start()
 
     def _run(self, traj: Any, fps: int, size: tuple[int, int], workers: int) -> None:
-        from activeintent.sim.video import export_video
-
         try:
             # the MP4 from the same frames; the file is complete when both are
             export_video(traj, self.path, fps=fps, size=size, workers=workers, also=(self.path.with_suffix(".mp4"),))

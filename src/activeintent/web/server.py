@@ -25,9 +25,11 @@ from fastapi.responses import FileResponse, StreamingResponse
 from fastapi.staticfiles import StaticFiles
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
+from activeintent.runner import build_episode
 from activeintent.signals import SIGNALS, AnswerRejected, Signal, WebForm, get_signal
 from activeintent.signals import Answer as SignalAnswer
 from activeintent.signals.base import MAX_ROUND
+from activeintent.sim.render import warm_render_pool
 from activeintent.users.human import Question
 from activeintent.web.errors import ApiError, install_error_handlers
 from activeintent.web.limits import BodyGuard, Limits, SessionLimits, event_lines_size
@@ -270,8 +272,6 @@ def create_app(
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
-        from activeintent.sim.render import warm_render_pool
-
         # the render processes start now, not during the first participant's first wait
         if not await asyncio.to_thread(warm_render_pool, config.render_workers) and config.render_workers > 1:
             log.warning("the %d render processes could not start: every video is drawn in the server's "
@@ -505,8 +505,6 @@ def runner_builder(config: StudyConfig) -> EpisodeBuilder:
     show = "first-feasible" if config.design == "assigned-rule" else "learner-showable"
 
     def build(seed: int, out_dir: Path, user, observers):
-        from activeintent.runner import build_episode
-
         return build_episode(run.with_options(seed=seed), out_dir, user=user, observers=observers, show_final=show)
 
     return build

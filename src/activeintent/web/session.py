@@ -35,16 +35,20 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, Field, computed_field, field_validator, model_validator
 
+from activeintent.envs import ENVS
 from activeintent.protocol import FORMAT_VERSION
 from activeintent.records import EpisodeRecorder, dumps
 from activeintent.signals import AnswerRejected, ShownRound
 from activeintent.spec import RunSpec
+from activeintent.suites import resolve
 from activeintent.users.human import HumanUser, Question, SessionCancelled
 from activeintent.web.basics import VIDEO_SIZE, EstimateMode, parse_video_size, write_json
 from activeintent.web.errors import ApiError
 from activeintent.web.live import LiveExport
 from activeintent.web.questionnaire import Questionnaire
+from activeintent.web.study import Assigner, button_order
 from activeintent.web.videos import SessionVideos, VideoInfo
+from activeintent.world import COLORS
 
 SESSION_ID = re.compile(r"^[0-9a-f]{16}$")
 KEY_ID_CHARS = 16  # of the key's SHA-256: enough to tell browsers apart, useless to forge one
@@ -121,8 +125,6 @@ class StudyConfig(BaseModel):
     @field_validator("run")
     @classmethod
     def _people_watch_physics(cls, run: RunSpec) -> RunSpec:
-        from activeintent.envs import ENVS
-
         ENVS.check(run.env.name)
         if run.protocol.budget < 1:
             raise ValueError("a study asks each participant for at least one signal (budget ≥ 1)")
@@ -131,8 +133,6 @@ class StudyConfig(BaseModel):
     @model_validator(mode="after")
     def _describe_rule(self) -> StudyConfig:
         if self.design == "assigned-rule" and (self.intention_name is None or self.intention_description is None):
-            from activeintent.suites import resolve
-
             who = self.run.user
             rule = resolve(None if who.intention_file else who.intention, who.intention_file)
             self.intention_name = rule.name
@@ -234,8 +234,6 @@ def guess_of(estimate: Any, answers: int, belief_top: Any = None) -> Guess:
 
 def scene_legend(objects: list[str]) -> list[dict]:
     """The scene's objects by name, with their colour (for the pages' colour-name legend)."""
-    from activeintent.world import COLORS
-
     legend = []
     for name in objects:
         color, _, kind = name.partition(" ")
@@ -611,8 +609,6 @@ class SessionManager:
 
     def __init__(self, config: StudyConfig, builder: EpisodeBuilder,
                  conditions: dict[str, tuple[StudyConfig, EpisodeBuilder]] | None = None, study: Any = None):
-        from activeintent.web.study import Assigner
-
         self.config, self.builder, self.study = config, builder, study
         self.conditions = conditions or {"single": (config, builder)}
         self._sessions: dict[str, WebSession] = {}
@@ -669,8 +665,6 @@ class SessionManager:
     def begin(self, session: WebSession) -> WebSession:
         """Start an enrolled session's episode: it is counted in its condition now (the one it
         was told of), gets its seed and button order, and runs."""
-        from activeintent.web.study import button_order
-
         study = self.study
         with self._lock:
             if session.begun or not session.active:

@@ -30,6 +30,9 @@ from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from activeintent.learners.registry import check_method
+from activeintent.signals import get_signal
+from activeintent.suites import resolve
 from activeintent.web.basics import ESTIMATE_MODES, EstimateMode, write_json
 
 # Participant IDs come from a link (Prolific and similar put 24 hex digits there): short, and
@@ -65,16 +68,12 @@ class Condition(BaseModel):
     @field_validator("method")
     @classmethod
     def _known_method(cls, v: str) -> str:
-        from activeintent.learners.registry import check_method
-
         check_method(v)  # its error lists the methods there are
         return v
 
     @model_validator(mode="after")
     def _known_rule(self) -> Condition:
         if self.intention or self.intention_file:
-            from activeintent.suites import resolve
-
             try:
                 resolve(None if self.intention_file else self.intention, self.intention_file)
             except Exception as err:  # the resolver's message lists the rules there are
@@ -206,8 +205,6 @@ class Assigner:
 
 def button_order(signal: str, slot: int, counterbalance: bool = True) -> list[str]:
     """The answer buttons of participant ``slot`` (the signal's counterbalanced order)."""
-    from activeintent.signals import get_signal
-
     return get_signal(signal).button_order(slot, counterbalance)
 
 

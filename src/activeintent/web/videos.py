@@ -9,14 +9,13 @@ from typing import Any
 
 from pydantic import BaseModel, Field
 
+from activeintent.sim.video import export_video, frame_times
 from activeintent.web.live import LiveExport
 
 
 def video_frames(traj: Any, fps: int) -> int:
     """Frames of the exported video of τ: one per 1/fps s from 0, plus the last tick when the
     duration is not a whole number of frames (``activeintent.sim.video.frame_times``)."""
-    from activeintent.sim.video import frame_times
-
     return len(frame_times(traj, fps))
 
 
@@ -57,8 +56,6 @@ class SessionVideos:
 
     def export_whole(self, traj: Any, name: str, label: str) -> VideoInfo:
         """The whole video, written before this returns (the final attempt)."""
-        from activeintent.sim.video import export_video
-
         export_video(traj, self.dir / f"{name}.webm", fps=self.fps, size=self.size, workers=self.workers,
                      also=(self.dir / f"{name}.mp4",))
         return self.info(traj, name, label)

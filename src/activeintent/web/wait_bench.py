@@ -20,6 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
+from activeintent.learners.registry import get_method
+from activeintent.spec import RunSpec
+
 POLL_S = 0.02
 READY = ("waiting-for-answer", "finished", "failed", "cancelled")
 
@@ -35,8 +38,7 @@ def measure_waits(method: str, rounds: int, video_size: tuple[int, int], seed: i
     """Seconds from each answer until the next round (or the end) is ready, for one session."""
     from fastapi.testclient import TestClient
 
-    from activeintent.learners.registry import get_method
-    from activeintent.spec import RunSpec
+    # lazy: FastAPI loads only when the bench runs
     from activeintent.web.server import create_app, runner_builder
     from activeintent.web.session import StudyConfig
 

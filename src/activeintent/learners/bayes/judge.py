@@ -9,7 +9,7 @@ import numpy as np
 from activeintent.goals.facts import Facts, facts
 from activeintent.learners.bayes.hypotheses import Hypothesis
 from activeintent.memo import BoundedCache, IdentityCache
-from activeintent.world import WorldState
+from activeintent.world import Scene, WorldState
 from activeintent.world.trajectory import Trajectory
 
 _TOKENS = itertools.count()
@@ -158,8 +158,6 @@ class HypothesisJudge:
         key = tuple(objects)
         got = self._feasible.get(key)
         if got is None:
-            from activeintent.world import Scene
-
             scene = Scene(objects=list(key))
             comp = _compiled(self.hyps, self.token)
             got = np.zeros(self.size, dtype=bool)

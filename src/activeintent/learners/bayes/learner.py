@@ -30,6 +30,7 @@ from activeintent.learners.bayes.belief import Belief, Prior
 from activeintent.learners.bayes.candidates import candidate_plans, predict
 from activeintent.learners.bayes.hypotheses import Hypothesis, hypothesis_space
 from activeintent.learners.bayes.judge import HypothesisJudge
+from activeintent.learners.bayes.proposals import propose_hypotheses
 from activeintent.learners.bayes.scenes import SCENE_DESIGNS
 from activeintent.llm.base import ChatModel, ModelError
 from activeintent.signals import Answer, Signal, get_signal
@@ -286,8 +287,6 @@ class BayesLearner(Learner):
     # ---- open-ended hypotheses ----
 
     def _propose(self) -> list[str]:
-        from activeintent.learners.bayes.proposals import propose_hypotheses
-
         self.proposal_calls += 1
         try:
             new = propose_hypotheses(self.llm, self.top(5), self.observations)  # type: ignore[arg-type]

@@ -16,10 +16,13 @@ from typing import Protocol
 import numpy as np
 from pydantic import BaseModel, Field, field_validator
 
+from activeintent.act.guard import MAX_PROGRAM_CHARS
+from activeintent.act.sandbox import default_sandbox
 from activeintent.goals.facts import Facts, facts
-from activeintent.learners.bayes.hypotheses import Hypothesis
+from activeintent.learners.bayes.hypotheses import Hypothesis, random_scene
+from activeintent.learners.prompts import render
 from activeintent.llm.base import ChatModel, Message
-from activeintent.world import WorldState
+from activeintent.world import WorldState, layout
 from activeintent.world.colors import WARM_COLORS
 from activeintent.world.scene import color_of
 
@@ -84,8 +87,6 @@ def batch_program(body: str, worlds: list[dict]) -> str:
 def batch_programs(body: str, worlds: list[dict], limit: int | None = None) -> list[tuple[str, list[dict]]]:
     """``batch_program`` over consecutive groups of ``worlds``, each program within the sandbox's
     size limit (so that many worlds make several programs, never one that is refused)."""
-    from activeintent.act.guard import MAX_PROGRAM_CHARS
-
     limit = limit or MAX_PROGRAM_CHARS
     base = len(batch_program(body, []))
     groups: list[list[dict]] = []
@@ -110,8 +111,6 @@ class SandboxRunner:
         self._sandbox = sandbox
 
     def __call__(self, body: str, worlds: list[dict]) -> list[bool]:
-        from activeintent.act.sandbox import default_sandbox
-
         sandbox = self._sandbox or default_sandbox()
         out = ""
         for program, group in batch_programs(body, worlds):
@@ -195,8 +194,6 @@ def propose_hypotheses(
     runner: PredicateRunner | None = None,
 ) -> list[Hypothesis]:
     """Ask ``llm`` for new z; keep those whose predicate compiles and runs in the sandbox."""
-    from activeintent.learners.prompts import render
-
     prompt = render(
         "eq1_bayes_hypotheses",
         candidates="\n".join(f"- {h.description} (belief {w:.2f})" for h, w in top),
@@ -209,8 +206,6 @@ def propose_hypotheses(
     probes = [f for obs in observations for f in obs.finals][:6]
     if not probes:
         rng = np.random.default_rng(0)
-        from activeintent.learners.bayes.hypotheses import random_scene
-        from activeintent.world import layout
 
         probes = [facts(WorldState(positions=layout(random_scene(rng), 0)))]
     out = []

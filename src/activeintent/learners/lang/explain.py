@@ -17,6 +17,8 @@ from collections import Counter
 from functools import cache, lru_cache
 
 from activeintent.goals.language import NODES, Goal, all_clauses, nodes, spoken
+from activeintent.learners.lang.learner import KEEP
+from activeintent.learners.lang.space import goal_space, space_info
 
 MIN_SCORE = 0.45
 STOP = {"the", "a", "an", "is", "are", "be", "should", "to", "of", "on", "in", "and", "it", "its", "their",
@@ -120,9 +122,6 @@ def explain(sentence: str, n: int = 5) -> dict:
 
 def language_summary(examples: int = 12) -> dict:
     """Node types with their parameters and bits, the counts of the space, examples."""
-    from activeintent.learners.lang.learner import KEEP
-    from activeintent.learners.lang.space import goal_space, space_info
-
     kinds = {}
     for kind in NODES:
         kinds[kind] = [{"key": k, "choices": len(node.params), "bits": round(node.bits(), 2),

@@ -214,7 +214,7 @@ def lang_method(signal: str) -> Method:
                                              language=ctx.config.language))
 
     return Method(signal, False, build, f"ours: growing belief over the goal language, {signal} queries by EIG",
-                  goal_language=True)
+                  goal_language=True, colour={"stop": "#2ca02c", "preference": "#98df8a"}.get(signal))
 
 
 def lang_zero_signal() -> Method:

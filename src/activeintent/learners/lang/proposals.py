@@ -25,6 +25,7 @@ from typing import Literal
 from pydantic import BaseModel, Field, create_model
 
 from activeintent.goals.language import MAX_CLAUSES, QUANTS, Each, Form, Goal, nodes
+from activeintent.learners.prompts import render
 from activeintent.llm.base import ChatModel, Message
 from activeintent.world.colors import COLOR_NAMES
 
@@ -140,8 +141,6 @@ def to_goal(proposal) -> Goal | None:
 def propose_goals(llm: ChatModel, likely: list[tuple[Goal, float]], history: str, count: int = 3,
                   seed: int | None = None) -> tuple[list[Goal], int]:
     """Ask ``llm`` for up to ``count`` goals given h; returns (goals that fit, goals answered)."""
-    from activeintent.learners.prompts import render
-
     prompt = render(
         "eq1_lang_goals",
         likely="\n".join(f"- {g.sentence()} (belief {w:.2f})\n  = {_as_fields(g)}" for g, w in likely),

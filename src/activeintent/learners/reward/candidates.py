@@ -19,7 +19,9 @@ import numpy as np
 from activeintent import ranking
 from activeintent.envs.symbolic import symbolic_trajectory
 from activeintent.goals.facts import facts, state_key
-from activeintent.learners.bayes.candidates import Outcome
+from activeintent.learners.bayes.belief import Belief
+from activeintent.learners.bayes.candidates import Outcome, candidate_plans
+from activeintent.learners.bayes.hypotheses import hypothesis_space
 from activeintent.learners.reward.features import N_FEATURES, phi
 from activeintent.world import PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState, apply_skill
 from activeintent.world.skills import TABLE_POSITIONS
@@ -142,8 +144,6 @@ def feature_plans(pool: Pool, features: np.ndarray, depth: int = 2) -> None:
 
 def planner_plans(pool: Pool, rng: np.random.Generator, limit: int = 24, prefixes: bool = True) -> None:
     """The Bayesian learners' planner on the prior over its hypotheses (no answer involved)."""
-    from activeintent.learners.bayes.candidates import candidate_plans
-
     hyps, w = _prior()
     feasible = np.fromiter((h.feasible(pool.state.scene) for h in hyps), bool, len(hyps))
     for o in candidate_plans(hyps, w, pool.state, rng, top_k=16, explore=6, prefixes=prefixes,
@@ -153,9 +153,6 @@ def planner_plans(pool: Pool, rng: np.random.Generator, limit: int = 24, prefixe
 
 @functools.cache
 def _prior():
-    from activeintent.learners.bayes.belief import Belief
-    from activeintent.learners.bayes.hypotheses import hypothesis_space
-
     b = Belief(tuple(hypothesis_space(0)), "length")
     return b.hyps, b.weights
 

@@ -1,10 +1,10 @@
 """Benchmark suites of hidden intentions: ``paper`` (the paper's four), ``library`` (the other
 built-in intentions), ``heldout`` (written blind, before any learner change, in
-``intentions/suites/heldout.py``; reported separately), ``heldout2`` (a second held-out suite, ``h2-…``,
-written blind with the world's helpers only, in ``intentions/suites/heldout2.py``; reported
-separately, like ``heldout``), ``dev`` (``intentions/suites/dev.py``: for tuning learners) and
+``suites/heldout.py``; reported separately), ``heldout2`` (a second held-out suite, ``h2-…``,
+written blind with the world's helpers only, in ``suites/heldout2.py``; reported
+separately, like ``heldout``), ``dev`` (``suites/dev.py``: for tuning learners) and
 ``truth-goals`` (``truth-00`` … ``truth-49``: 50 goals of the goal language drawn at random and
-committed as data, ``bench/truth_goals.json``; learning efficiency apart from coverage).
+committed as data, ``suites/truth_goals.json``; learning efficiency apart from coverage).
 Names of every suite resolve everywhere an intention name is accepted. Suites are the registry
 :data:`SUITES`; a plug-in file adds its own (``SUITES.register("mine", Suite(load=...))``).
 """
@@ -25,6 +25,10 @@ from activeintent.intentions.registry import (
     resolve_intention,
 )
 from activeintent.registry import Registry, UnknownName
+from activeintent.suites.dev import dev_intentions
+from activeintent.suites.heldout import heldout_intentions
+from activeintent.suites.heldout2 import heldout2_intentions
+from activeintent.suites.truth_goals import truth_intentions
 
 
 @dataclass(frozen=True)
@@ -46,26 +50,18 @@ def _library() -> dict[str, Intention]:
 
 
 def _heldout() -> dict[str, Intention]:
-    from activeintent.intentions.suites.heldout import heldout_intentions
-
     return {it.name: it for it in heldout_intentions()}
 
 
 def _heldout2() -> dict[str, Intention]:
-    from activeintent.intentions.suites.heldout2 import heldout2_intentions
-
     return {it.name: it for it in heldout2_intentions()}
 
 
 def _dev() -> dict[str, Intention]:
-    from activeintent.intentions.suites.dev import dev_intentions
-
     return {it.name: it for it in dev_intentions()}
 
 
 def _truth() -> dict[str, Intention]:
-    from activeintent.bench.truth_goals import truth_intentions
-
     return {it.name: it for it in truth_intentions()}
 
 

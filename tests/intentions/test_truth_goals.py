@@ -1,4 +1,4 @@
-"""The truth-goal suite (bench/truth_goals.py, bench/truth_goals.json): drawn for the current
+"""The truth-goal suite (suites/truth_goals.py, suites/truth_goals.json): drawn for the current
 goal language, reproducible from its seed, uniform over the language's structure, every goal
 well-formed and showable, and the suite resolves everywhere an intention name is accepted."""
 
@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from activeintent.bench import truth_goals as tg
+from activeintent.suites import truth_goals as tg
 from activeintent.bench.report import MIN_SCORED
 from activeintent.goals.language import NODES, QUANTS, Each, nodes, parse_goal
 from activeintent.learners.lang.hypotheses import GoalIntention
@@ -26,7 +26,7 @@ GOALS = DATA["goals"]
 
 def test_the_committed_suite_is_drawn_for_the_current_language():
     assert DATA["language_version"] == tg.language_version(), (
-        "the goal language changed since bench/truth_goals.json was drawn: redraw it with "
+        "the goal language changed since suites/truth_goals.json was drawn: redraw it with "
         f"`{tg.REDRAW}` (from the repository root, with src on PYTHONPATH) and commit the file")
     settings = tg.settings(DATA["seed"])
     assert {k: DATA[k] for k in settings} == settings, f"the draw's settings changed: `{tg.REDRAW}`"

@@ -38,8 +38,8 @@ version, the seed, the filter settings, the draw's counts and the 50 goal keys w
 sentences. A change of the language changes its version and a test then fails until the suite
 is redrawn::
 
-    python -m activeintent.bench.truth_goals --redraw   # rewrites truth_goals.json
-    python -m activeintent.bench.truth_goals --check    # redraws in memory, compares
+    python -m activeintent.suites.truth_goals --redraw   # rewrites truth_goals.json
+    python -m activeintent.suites.truth_goals --check    # redraws in memory, compares
 
 Names are neutral (``truth-00`` … ``truth-49``); each intention's description is its goal's
 sentence.
@@ -90,7 +90,7 @@ MAX_ALREADY = 0.8  # share of its feasible scenes whose initial layout already s
 MIN_SCORED = 5  # feasible scenes in every default trial's pool, at least (bench.report.MIN_SCORED)
 DEFAULT_TRIALS = 20  # trials of a default bench (bench --trials)
 NAME_PREFIX = "truth-"
-REDRAW = "python -m activeintent.bench.truth_goals --redraw"
+REDRAW = "python -m activeintent.suites.truth_goals --redraw"
 
 
 LANGUAGE = 1  # the goal language's version the suite is drawn from (goals/language.py LANGUAGES)
@@ -246,7 +246,7 @@ def draw(seed: int = SEED, count: int = COUNT) -> dict:
         kept.append({"name": f"{NAME_PREFIX}{len(kept):02d}", "key": goal.key, "sentence": goal.sentence(),
                      "clauses": len(goal.clauses), "feasible": round(feasible, 4), "already": round(already, 4), "fewest_scored": scored})
     return {
-        "about": "The truth-goal suite (--suite truth-goals), drawn by activeintent.bench.truth_goals; "
+        "about": "The truth-goal suite (--suite truth-goals), drawn by activeintent.suites.truth_goals; "
                  f"do not edit by hand: redraw with `{REDRAW}`.",
         "language_version": language_version(),
         "language": {"clauses": _clause_count(), "max_clauses": MAX_CLAUSES, "quants": list(QUANTS)},
@@ -313,7 +313,7 @@ def write(data: dict, path: Path = PATH) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m activeintent.bench.truth_goals", description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m activeintent.suites.truth_goals", description=__doc__.split("\n\n")[0])
     group = parser.add_mutually_exclusive_group(required=True)
     group.add_argument("--redraw", action="store_true", help=f"redraw and rewrite {PATH.name}")
     group.add_argument("--check", action="store_true", help=f"redraw in memory and compare with {PATH.name}")
