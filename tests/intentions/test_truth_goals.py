@@ -13,11 +13,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from activeintent.suites import truth_goals as tg
 from activeintent.bench.report import MIN_SCORED
 from activeintent.goals.language import NODES, QUANTS, Each, nodes, parse_goal
 from activeintent.learners.lang.hypotheses import GoalIntention
 from activeintent.suites import SUITE_NAMES, resolve, suite, suite_of
+from activeintent.suites import truth_goals as tg
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = tg.committed()
