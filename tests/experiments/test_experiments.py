@@ -28,7 +28,7 @@ EPISODES = {
     "grammar-intentions/grammar_intentions.py": ("bayes-stop", None, f"{GRAMMAR}:PINK_BOWL"),
 }
 SCRIPTS = {"decide/clairvoyant_bound.py", "defaults/compare.py", "defaults/compare_bayes.py",
-           "answered-scenes/compare.py"}  # their own command line
+           "answered-scenes/compare.py", "prior-pass3/compare.py"}  # their own command line
 DESIGNS = {"answered-scenes/answered.py": "answered"}  # plug-in file → the scene design it registers
 HELPERS = {"decide/acquisition.py", "decide/decision.py", "decide/needs.py", "decide/plans.py"}  # loaded by the above
 
