@@ -142,7 +142,6 @@ def build_episode(
             user.profile = user.profile.model_copy(update={"new_scene_false": 0.0, "new_scene_miss": 1.0})
     observers = list(observers or [])
     if getattr(intention, "goal", None) is not None:  # a goal as the hidden intention: track p(goal)
-
         if (tracker := truth_tracker(learner, intention)) is not None:
             observers.append(tracker)
     return Episode(learner, intention, user, executor, env or make_env(spec.env.name), spec.protocol, observers,

@@ -13,12 +13,8 @@ from __future__ import annotations
 import os
 from collections.abc import Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
 
-from activeintent.bench.work import protocol_fields, run_item
-
-if TYPE_CHECKING:
-    from activeintent.bench.work import BenchConfig, WorkItem
+from activeintent.bench.work import BenchConfig, WorkItem, protocol_fields, run_item
 
 BACKENDS = ("local", "ray")
 

@@ -169,11 +169,20 @@ def peer_of(signal: str | None) -> str | None:
     return next((n for n in METHODS.names() if (m := _method(n)) and m.family == "peer" and m.signal == signal), None)
 
 
+def _signal_of(method: str) -> str | None:
+    """Its registry entry's signal; for a plug-in method not loaded here, its name's last word
+    when that is the signal of a peer."""
+    if (m := _method(method)) is not None:
+        return m.signal
+    tail = method.rsplit("-", 1)[-1]
+    return tail if peer_of(tail) else None
+
+
 def peer_pairs(methods: list[str]) -> list[tuple[str, str]]:
     """(learner, the reward peer of its signal) for every learner of the bench that has one."""
     out = []
     for m in methods:
-        peer = peer_of(getattr(_method(m), "signal", None))
+        peer = peer_of(_signal_of(m))
         if peer in methods and m != peer and not is_baseline(m) and not m.startswith(peer):
             out.append((m, peer))
     return out
