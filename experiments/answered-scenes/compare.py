@@ -14,7 +14,7 @@ import json
 import sys
 from pathlib import Path
 
-from activeintent.bench.report import auc, paired_comparison, wilson
+from activeintent.bench.report import arm_row, paired_comparison
 from activeintent.results import read_results
 
 HERE = Path(__file__).resolve().parent
@@ -39,15 +39,7 @@ def summary(records: dict[str, list[dict]]) -> dict:
     rows, paired = [], []
     for arm, rs in records.items():
         for method in LEARNERS:
-            ok = [r for r in rs if r["method"] == method and r.get("success") is not None]
-            mean = sum(r["success"] for r in ok) / len(ok)
-            lo, hi = wilson(mean * len(ok), len(ok))
-            areas = [a for a in (auc(r.get("success_at") or []) for r in ok) if a is not None]
-            answers = sum(sum(r.get("answers", {}).values()) for r in ok)
-            new_scene = sum(r.get("answers", {}).get("new_scene", 0) for r in ok)
-            rows.append({"arm": arm, "method": method, "n": len(ok), "success": mean, "lo": lo, "hi": hi,
-                         "area": sum(areas) / len(areas), "answers": answers, "new_scene": new_scene,
-                         "new_scene_share": new_scene / answers if answers else None})
+            rows.append({"arm": arm, **arm_row(rs, method)})
             if arm != BASELINE:
                 c = paired_comparison(pooled, f"{method}@{arm}", f"{method}@{BASELINE}")
                 if c is not None:

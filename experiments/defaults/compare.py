@@ -15,7 +15,7 @@ import json
 import sys
 from pathlib import Path
 
-from activeintent.bench.report import auc, paired_comparison, wilson
+from activeintent.bench.report import arm_row, paired_comparison
 from activeintent.results import read_results
 
 REPO = Path(__file__).resolve().parents[2]
@@ -44,17 +44,8 @@ def summary(records: dict[str, list[dict]]) -> dict:
     rows = []
     for arm, rs in records.items():
         for method in (*LEARNERS, "lang-zero-signal"):
-            ok = [r for r in rs if r["method"] == method and r.get("success") is not None]
-            if not ok:
-                continue
-            mean = sum(r["success"] for r in ok) / len(ok)
-            lo, hi = wilson(mean * len(ok), len(ok))
-            areas = [a for a in (auc(r.get("success_at") or []) for r in ok) if a is not None]
-            answers = [sum(r.get("answers", {}).values()) for r in ok]
-            new_scene = [r.get("answers", {}).get("new_scene", 0) for r in ok]
-            rows.append({"arm": arm, "method": method, "n": len(ok), "success": mean, "lo": lo, "hi": hi,
-                         "area": sum(areas) / len(areas) if areas else None,
-                         "new_scene_share": sum(new_scene) / sum(answers) if sum(answers) else None})
+            if (row := arm_row(rs, method)) is not None:
+                rows.append({"arm": arm, **row})
     paired = []
     ran = [arm for arm in ARMS[1:] if arm in records]
     for arm in ran:

@@ -16,7 +16,7 @@ import json
 import sys
 from pathlib import Path
 
-from activeintent.bench.report import auc, paired_comparison, wilson
+from activeintent.bench.report import arm_row, paired_comparison
 from activeintent.results import read_results
 
 HERE = Path(__file__).resolve().parent
@@ -35,14 +35,7 @@ def summary(folder: Path) -> dict:
     rows, paired = [], []
     for arm, rs in arms.items():
         for method in LEARNERS:
-            ok = [r for r in rs if r["method"] == method and r.get("success") is not None]
-            mean = sum(r["success"] for r in ok) / len(ok)
-            lo, hi = wilson(mean * len(ok), len(ok))
-            areas = [a for a in (auc(r.get("success_at") or []) for r in ok) if a is not None]
-            answers = sum(sum(r.get("answers", {}).values()) for r in ok)
-            new_scene = sum(r.get("answers", {}).get("new_scene", 0) for r in ok)
-            rows.append({"arm": arm, "method": method, "n": len(ok), "success": mean, "lo": lo, "hi": hi,
-                         "area": sum(areas) / len(areas), "new_scene": new_scene, "answers": answers})
+            rows.append({"arm": arm, **arm_row(rs, method)})
     for method in LEARNERS:
         c = paired_comparison(pooled, f"{method}@belief", f"{method}@sampled")
         if c is not None:

@@ -111,6 +111,23 @@ def auc(curve: list[float | None]) -> float | None:
     return None if not curve or any(v is None for v in curve) else float(np.mean(curve))
 
 
+def arm_row(records: list[dict], method: str) -> dict | None:
+    """One method's scored episodes, as an experiment's comparison of arms shows them: n, mean
+    success@K with its Wilson interval, mean area under success@k, all answers and the "new scene"
+    ones (None when no episode was scored)."""
+    ok = [r for r in records if r["method"] == method and r.get("success") is not None]
+    if not ok:
+        return None
+    mean = sum(r["success"] for r in ok) / len(ok)
+    lo, hi = wilson(mean * len(ok), len(ok))
+    areas = [a for a in (auc(r.get("success_at") or []) for r in ok) if a is not None]
+    answers = sum(sum(r.get("answers", {}).values()) for r in ok)
+    new_scene = sum(r.get("answers", {}).get("new_scene", 0) for r in ok)
+    return {"method": method, "n": len(ok), "success": mean, "lo": lo, "hi": hi,
+            "area": sum(areas) / len(areas) if areas else None, "answers": answers, "new_scene": new_scene,
+            "new_scene_share": new_scene / answers if answers else None}
+
+
 def paired_difference(records: list[dict], a: str, b: str) -> dict | None:
     """Method ``a`` minus ``b`` in AUC on the same episodes (same intention and trial: same query-
     scene seeds, user noise and test scenes): mean, 95 % interval (normal approximation of the
