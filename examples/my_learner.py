@@ -14,7 +14,7 @@ and how reports show it (its colour, the method it is paired with on the same tr
 
 from __future__ import annotations
 
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, ConfigDict, Field
 
 from activeintent.learners.bayes.acquisition import Query
 from activeintent.learners.bayes.candidates import candidate_plans
@@ -24,9 +24,12 @@ from activeintent.world import WorldState
 
 
 class GreedyConfig(BaseModel):
-    """The learner's own settings."""
+    """The learner's own settings: each field is a setting of its methods, an option of `run`,
+    `bench` and `serve` (``--likely 3``) and a field of their records."""
 
-    likely: int = Field(2, ge=1, description="plans come from this many most probable goals")
+    model_config = ConfigDict(extra="forbid")
+
+    likely: int = Field(2, ge=1, description="Plans come from this many most probable goals")
 
 
 class GreedyLearner(BayesLearner):
@@ -48,11 +51,11 @@ class GreedyLearner(BayesLearner):
 
 def _method(signal: str) -> Method:
     def build(ctx: LearnerContext) -> GreedyLearner:
-        return GreedyLearner(signal, rng=ctx.learner_seed)
+        return GreedyLearner(signal, rng=ctx.learner_seed, greedy=ctx.settings)  # type: ignore[arg-type]
 
     # reports pair it with bayes-<signal> (everything but the query choice is the same) and draw it in this colour
     return Method(signal, False, build, f"example: shows the plans of its likeliest goals ({signal})",
-                  colour="#393b79", compared_with=f"bayes-{signal}")
+                  colour="#393b79", compared_with=f"bayes-{signal}", settings=GreedyConfig)
 
 
 for _signal in ("stop", "preference"):

@@ -10,13 +10,14 @@ import pytest
 from activeintent.act.executors import make_executor
 from activeintent.envs.symbolic import SymbolicEnv
 from activeintent.episode import Episode
+from activeintent.learners.paper.structured import PaperSettings
 from activeintent.learners.registry import LearnerContext, get_method
 from activeintent.llm.scripted import ScriptedModel
 from activeintent.protocol import FORMAT_VERSION, trial_seeds
 from activeintent.records import read_rounds
 from activeintent.runner import RunSpec, build_episode
 from activeintent.signals import get_signal
-from activeintent.spec import LearnerConfig, ProtocolConfig
+from activeintent.spec import ProtocolConfig
 from activeintent.suites import resolve
 from activeintent.users.simulated import SimulatedUser, user_profile
 
@@ -143,7 +144,7 @@ def scripted_answers(messages, schema):
 
 def test_an_ungroundable_goal_then_no_stop_is_a_failed_execution_not_approval(tmp_path):
     model = ScriptedModel(respond=scripted_answers, accepts_images=False)
-    learner = get_method("mllm-llm")(LearnerContext(llm=model, config=LearnerConfig(variant="structured")))
+    learner = get_method("mllm-llm")(LearnerContext(llm=model, settings=PaperSettings(variant="structured")))
     user = ScriptedUser("stop", [{"stop_time": None}])
     # An executor that can ground nothing: every y fails to become motion.
     executor = make_executor("parse")
@@ -159,7 +160,7 @@ def test_an_ungroundable_goal_then_no_stop_is_a_failed_execution_not_approval(tm
 
 def test_model_calls_are_counted_when_built_from_python():
     model = ScriptedModel(respond=scripted_answers, accepts_images=False)
-    learner = get_method("preference")(LearnerContext(llm=model, config=LearnerConfig(variant="structured")))
+    learner = get_method("preference")(LearnerContext(llm=model, settings=PaperSettings(variant="structured")))
     user = SimulatedUser(resolve("color-match"), "preference", user_profile("exact"), rng=0)
 
     def usage():

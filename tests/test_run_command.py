@@ -7,6 +7,7 @@ from pathlib import Path
 
 from typer.testing import CliRunner
 
+from activeintent.bench.legacy import migrated
 from activeintent.cli import app
 
 runner = CliRunner()
@@ -80,11 +81,12 @@ def test_run_prints_a_line_per_signal_when_stdout_is_not_a_terminal(tmp_path):
 
 def test_a_bench_record_replays_with_its_seed_and_test_seed(tmp_path):
     """`run --seed S --test-seed T` is the bench's episode: a committed record's success@k comes back
-    (T is the record's config.options.test_seed; the top-level test_seed is the test stream's)."""
+    (T is the record's config.spec.protocol.test_seed; the top-level test_seed is the test stream's)."""
     results = Path(__file__).resolve().parents[1] / "docs" / "results" / "truth-goals-exact" / "results.jsonl"
     record = next(r for r in map(json.loads, results.read_text().splitlines())
                   if r["method"] == "zero-signal" and r["intention"] == "truth-05")
-    options = record["config"]["options"]
+    spec = migrated(record)["config"]["spec"]
+    options = {"user": spec["user"]["preset"], "test_seed": spec["protocol"]["test_seed"]}
     args = ["run", "--method", "zero-signal", "--intention", "truth-05", "--budget", str(record["budget"]),
             "--user", options["user"], "--env", "symbolic", "--llm", "none", "--video", "none",
             "--seed", str(record["seed"])]

@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from activeintent.act.executors import make_executor
+from activeintent.bench.legacy import migrated
 from activeintent.envs.symbolic import SymbolicEnv
 from activeintent.episode import Episode
 from activeintent.goals.facts import facts
@@ -51,7 +52,8 @@ class ClairvoyantChooser(decide.DecideLearner):
     """decide-stop whose query choice reads the hidden intention (a bound, not a learner)."""
 
     def __init__(self, intention, rng, pool: int = 0, language: int = 1):
-        super().__init__("stop", rng=rng, config=decide.DecideConfig(**decide.DECIDE, pool=pool, language=language))
+        config = decide.DecideConfig(**decide.DECIDE, pool=pool, language=language, prior="length")  # as measured
+        super().__init__("stop", rng=rng, config=config)
         self.name = "clairvoyant-decide-stop"
         self.intention = intention
         self.truth = IntentionJudge(intention)
@@ -115,8 +117,8 @@ def run_one(record: dict) -> dict:
     protocol = ProtocolConfig(**record["config"]["episode"])  # the record's episode, seeds included
     seeds = protocol.seeds
     user = SimulatedUser(intention, "stop", user_profile("exact"), rng=seeds.user)
-    # the record's goal language (one written before the field ran in language 1)
-    language = record.get("config", {}).get("options", {}).get("language", 1)
+    # the record's goal language (a record of an older shape: bench.legacy gives the one it ran in)
+    language = migrated(record)["config"]["spec"]["learner"]["settings"]["language"]
     learner = ClairvoyantChooser(intention, seeds.learner, POOL, language)
     res = Episode(learner, intention, user, make_executor("plan"), SymbolicEnv(), protocol).run()
     return {"intention": record["intention"], "seed": record["seed"], "user_preset": "exact",

@@ -32,7 +32,13 @@ from activeintent.learners.bayes.candidates import candidate_plans, predict
 from activeintent.learners.bayes.hypotheses import random_scene
 from activeintent.learners.bayes.learner import Observation, kl_bits
 from activeintent.learners.lang.hypotheses import LangSpace
-from activeintent.learners.lang.learner import KEEP, LangConfig, LangJudge, LangLearner
+from activeintent.learners.lang.learner import (
+    KEEP,
+    LangConfig,
+    LangJudge,
+    LangLearner,
+    LangPriorSettings,
+)
 from activeintent.learners.registry import METHODS
 from activeintent.registry import load_plugin
 from activeintent.world import (
@@ -322,7 +328,7 @@ def decide_method(signal: str, name: str | None = None, keep: int = KEEP, descri
     name = name or f"decide-{signal}"
 
     def build(ctx: LearnerContext) -> DecideLearner:
-        config = DecideConfig(prior=ctx.config.prior, language=ctx.config.language, **{**DECIDE, **settings})
+        config = DecideConfig(**ctx.settings.model_dump(), **{**DECIDE, **settings})
         learner = DecideLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=config, keep=keep)
         learner.name = name
         return learner
@@ -331,7 +337,7 @@ def decide_method(signal: str, name: str | None = None, keep: int = KEEP, descri
     return Method(signal, False, build, description or f"experiment: the goal-language belief, scenes designed "
                   f"from it, {signal} queries by information about the decision", goal_language=True,
                   colour={"stop": "#d62728", "preference": "#ff9896"}[signal] if main else None,
-                  compared_with=f"lang-{signal}" if main else None)
+                  compared_with=f"lang-{signal}" if main else None, settings=LangPriorSettings)
 
 
 for _signal in ("stop", "preference"):

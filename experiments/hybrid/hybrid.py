@@ -34,7 +34,7 @@ import numpy as np
 
 from activeintent import ranking
 from activeintent.learners.base import Estimate, Learner, LearnerContext, Method, RoundRecord
-from activeintent.learners.lang.learner import LangConfig, LangLearner
+from activeintent.learners.lang.learner import LangConfig, LangLearner, LangPriorSettings
 from activeintent.learners.registry import METHODS
 from activeintent.learners.reward.learner import RewardConfig, RewardLearner
 from activeintent.learners.reward.models import lognormal_density
@@ -149,12 +149,12 @@ class HybridLearner(Learner):
 
 def hybrid_method(signal: str, decision: str = "mixture") -> Method:
     def build(ctx: LearnerContext) -> HybridLearner:
-        return HybridLearner(signal, ctx.learner_seed, lang=LangConfig(prior=ctx.config.prior, language=ctx.config.language), llm=ctx.llm,
+        return HybridLearner(signal, ctx.learner_seed, lang=LangConfig(**ctx.settings.model_dump()), llm=ctx.llm,
                              decision=decision)
 
     return Method(signal, False, build, f"ours: lang-{signal}'s belief and queries with a reward-feature "
                   "component that answers when it explains the answers better", goal_language=True,
-                  compared_with=f"lang-{signal}")
+                  compared_with=f"lang-{signal}", settings=LangPriorSettings)
 
 
 for _signal in ("preference", "stop"):

@@ -6,19 +6,19 @@
 goals join the belief after an answer (model proposals still would, with ``--llm``).
 """
 
-from activeintent.learners.lang.learner import LangConfig, LangLearner
+from activeintent.learners.lang.learner import LangConfig, LangLearner, LangSettings
 from activeintent.learners.registry import METHODS, LearnerContext, Method
 
 
 def _fixed(signal: str) -> Method:
     def build(ctx: LearnerContext) -> LangLearner:
-        learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=LangConfig(prior=ctx.config.prior, rejuvenate_top=0,
-                                                                                    language=ctx.config.language))
+        learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm,
+                              config=LangConfig(**ctx.settings.model_dump(), rejuvenate_top=0))
         learner.name = f"lang-fixed-{signal}"
         return learner
 
     return Method(signal, False, build, f"ablation: lang-{signal} without neighbours joining the belief",
-                  goal_language=True)
+                  goal_language=True, settings=LangSettings)
 
 
 for _signal in ("stop", "preference"):

@@ -32,7 +32,7 @@ import numpy as np
 
 from activeintent.learners.bayes.belief import Belief
 from activeintent.learners.lang.hypotheses import lang_space
-from activeintent.learners.lang.learner import KEEP, LangConfig, LangLearner
+from activeintent.learners.lang.learner import KEEP, LangConfig, LangLearner, LangPriorSettings
 from activeintent.learners.registry import METHODS, LearnerContext, Method
 
 FRAME = 'A person asked a robot arm to arrange the blocks and bowls on a table. They said: "'
@@ -116,8 +116,7 @@ def add_naturalness(belief: Belief, n_bits: np.ndarray, weight: float | None) ->
 
 
 def natural_learner(signal: str, weight: float | None, ctx: LearnerContext, name: str) -> LangLearner:
-    learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=LangConfig(prior=ctx.config.prior,
-                                                                                           language=ctx.config.language))
+    learner = LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=LangConfig(**ctx.settings.model_dump()))
     learner.name = name
     start = [g for sp in learner.base for g in sp.goals]  # the learner's own starting space, in order
     add_naturalness(learner.belief, sentence_bits([g.sentence() for g in start]), weight)
@@ -129,7 +128,8 @@ def _method(variant: str, signal: str) -> Method:
     name = f"lang-{variant}-{signal}"
     return Method(signal, False, lambda ctx: natural_learner(signal, weight, ctx, name),
                   f"ablation: lang-{signal} with a language model's naturalness in the prior "
-                  f"(λ = {'sd(L) / sd(N)' if weight is None else weight})", goal_language=True)
+                  f"(λ = {'sd(L) / sd(N)' if weight is None else weight})", goal_language=True,
+                  settings=LangPriorSettings)
 
 
 for _variant in WEIGHTS:

@@ -10,21 +10,21 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from pydantic import BaseModel
+
 from activeintent.act.executors import EXECUTORS, make_executor
 from activeintent.envs import ENVS, make_env
 from activeintent.episode import Episode
-from activeintent.goals.prior import load_prior
-from activeintent.learners.bayes.scenes import SCENE_DESIGNS
-from activeintent.learners.registry import LearnerContext, get_method
+from activeintent.learners.registry import LearnerContext, Method, get_method
 from activeintent.llm.embedded import EmbeddedConfig
 from activeintent.llm.registry import load_model, parse_spec
 from activeintent.registry import load_plugin
-from activeintent.spec import DEFAULT_INTENTION, DEFAULT_METHOD, ModelsConfig, RunSpec
+from activeintent.spec import DEFAULT_INTENTION, DEFAULT_METHOD, LearnerSpec, ModelsConfig, RunSpec
 from activeintent.suites import resolve as resolve_intention
 from activeintent.suites.truth_goals import truth_tracker
 from activeintent.users.simulated import USER_PRESETS, SimulatedUser, user_profile
 
-__all__ = ["DEFAULT_INTENTION", "DEFAULT_METHOD", "Models", "RunSpec", "build_episode", "check_spec", "with_method_defaults"]
+__all__ = ["DEFAULT_INTENTION", "DEFAULT_METHOD", "Models", "RunSpec", "build_episode", "check_spec", "for_method"]
 
 
 EXECUTOR_CTX = 8192  # the planner's prompts are ~750 tokens and its answers short
@@ -80,40 +80,38 @@ class Models:
         return float(sum(x.latency_s for x in self._totals()))
 
 
-def with_method_defaults(spec: RunSpec) -> RunSpec:
-    """The spec with the method's own value where it leaves a setting open (the prior), so that
-    what a record keeps is what ran."""
-    if spec.learner.prior is not None:
-        return spec
-
+def for_method(spec: RunSpec, name: str) -> RunSpec:
+    """The spec with method ``name`` and, of its settings, those that are that method's (a
+    benchmark gives one set of settings to methods of different kinds)."""
     for path in spec.plugins:
         load_plugin(path)
-    return spec.with_options(prior=get_method(spec.learner.method).default_prior)
+    own = get_method(name).own(spec.learner.settings)
+    return spec.model_copy(update={"learner": LearnerSpec(method=name, settings=own)})
+
+
+def _checked(spec: RunSpec) -> tuple[RunSpec, Method, BaseModel]:
+    for path in spec.plugins:
+        load_plugin(path)
+    name = spec.learner.method
+    method = get_method(name)
+    settings = method.configure(name, spec.learner.settings)
+    spec = spec.model_copy(update={"learner": LearnerSpec(method=name, settings=settings.model_dump(mode="json"))})
+    ENVS.check(spec.env.name)
+    USER_PRESETS.check(spec.user.preset)
+    if method.needs_llm and spec.models.llm == "none":
+        raise ValueError(f"--method {name} needs a language model; --llm none is only for methods "
+                         "that need none (bayes-*, zero-signal, random-query*).")
+    EXECUTORS.check(spec.act.executor)
+    for model in (spec.models.llm, spec.models.vlm):
+        if model not in (None, "none"):
+            parse_spec(model)  # a typo in a model spec is refused before any work
+    return spec, method, settings
 
 
 def check_spec(spec: RunSpec) -> RunSpec:
     """Refuse, before any work, a spec that cannot run; messages name the option and list choices.
-    Returns the spec that will run (the method's defaults filled in: :func:`with_method_defaults`)."""
-    for path in spec.plugins:
-        load_plugin(path)
-    method = get_method(spec.learner.method)
-    spec = with_method_defaults(spec)
-    if spec.learner.prior not in ("length", "uniform"):
-        if not method.goal_language:
-            raise ValueError(f"--prior {spec.learner.prior}: a fitted prior is over the goal language; "
-                             f"{spec.learner.method} takes length or uniform (lang-* take fitted and file:PATH)")
-        load_prior(spec.learner.prior, spec.learner.language)  # a missing, malformed or other-language file is refused before any work
-    ENVS.check(spec.env.name)
-    SCENE_DESIGNS.check(spec.learner.scenes)
-    USER_PRESETS.check(spec.user.preset)
-    if method.needs_llm and spec.models.llm == "none":
-        raise ValueError(f"--method {spec.learner.method} needs a language model; --llm none is only for methods "
-                         "that need none (bayes-*, zero-signal, random-query*).")
-    EXECUTORS.check(spec.learner.executor)
-    for model in (spec.models.llm, spec.models.vlm):
-        if model not in (None, "none"):
-            parse_spec(model)  # a typo in a model spec is refused before any work
-    return spec
+    Returns the spec that will run: the method's settings whole, its defaults filled in."""
+    return _checked(spec)[0]
 
 
 def build_episode(
@@ -126,16 +124,16 @@ def build_episode(
 ) -> Episode:
     """Everything before the loop starts. Errors in the spec are raised here, before any work.
     ``show_final``: see :class:`Episode` (the web study's final attempt; None for every run)."""
-    spec = check_spec(spec)
-    learning, who = spec.learner, spec.user
-    method = get_method(learning.method)
+    spec, method, settings = _checked(spec)
+    who = spec.user
     intention = resolve_intention(who.intention or (None if who.intention_file else DEFAULT_INTENTION),
                                   who.intention_file)
     models = Models(spec.models)
     seeds = spec.seeds  # the one split of the seed: the learner's and the user's streams come from it
     llm = models.llm
-    learner = method(LearnerContext(llm=llm, vlm=models.vlm, learner_seed=seeds.learner, config=learning))
-    executor = make_executor(learning.executor, model=models.executor_llm if llm is not None else None, parser_first=learning.variant == "structured")
+    learner = method(LearnerContext(llm=llm, vlm=models.vlm, learner_seed=seeds.learner, settings=settings))
+    executor = make_executor(spec.act.executor, model=models.executor_llm if llm is not None else None,
+                             parser_first=learner.executor_parses_first)
     if user is None:
         user = SimulatedUser(intention, method.signal, user_profile(who.preset), rng=seeds.user)
         if spec.protocol.new_scene == "off":
@@ -146,4 +144,5 @@ def build_episode(
             observers.append(tracker)
     return Episode(learner, intention, user, executor, env or make_env(spec.env.name), spec.protocol, observers,
                    usage=models.usage, model_time=models.model_time,
-                   extra_config={"options": spec.options()}, out_dir=out_dir, show_final=show_final)
+                   extra_config={"spec": spec.model_dump(mode="json", exclude={"plugins"})}, out_dir=out_dir,
+                   show_final=show_final)

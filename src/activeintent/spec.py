@@ -1,16 +1,16 @@
-"""The run specification: one :class:`RunSpec` says what one episode is, in five sections.
+"""The run specification: one :class:`RunSpec` says what one episode is, in six sections.
 
     protocol  what is measured and how (K, seeds, test scenes, the "new scene" rule, video)
     models    which LLM / MLLM answer and how their replies are cached
-    learner   the method and its settings (prior, ε, eq. 3's threshold, variant, y → plan)
+    learner   the method and its settings (its own config class says which: prior, ε, variant…)
+    act       how y becomes motion (the executor)
     env       where plans run
     user      who answers (the simulated user's preset) and the hidden intention
 
 `activeintent run`, `bench`, `serve` and the Python API all build one, validate it once and pass
-it whole to :func:`activeintent.runner.build_episode`. The command line speaks in flat option
-names (``--budget``, ``--llm``); :data:`OPTIONS` maps each to its section, and
-:meth:`RunSpec.from_options` / :meth:`RunSpec.options` convert (records and bench.json of earlier
-formats were written flat).
+it whole to :func:`activeintent.runner.build_episode`; records keep it as it ran. The command
+line speaks in option names (``--budget``, ``--llm``): a field's own name unless it says another
+(:func:`option_fields`); every other option is a learner setting.
 
 The seed is split once, here (:attr:`ProtocolConfig.seeds`), into the episode's named streams.
 """
@@ -22,9 +22,9 @@ from functools import cached_property
 from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic.fields import FieldInfo
 
-from activeintent.goals.language import LATEST, check_language
 from activeintent.protocol import (
     DEFAULT_BUDGET,
     DEFAULT_TEST_POOL,
@@ -34,7 +34,6 @@ from activeintent.protocol import (
 
 DEFAULT_METHOD = "bayes-stop"
 DEFAULT_INTENTION = "color-match"
-VARIANTS = ("faithful", "structured")
 
 
 @dataclass(frozen=True)
@@ -62,17 +61,21 @@ class ProtocolConfig(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    budget: int = Field(DEFAULT_BUDGET, ge=0, le=100, description="K: signals the user gives")
-    seed: int = Field(0, ge=0, description="seed of the episode's query scenes, user noise and learner")
-    test_seed: int | None = Field(None, ge=0, description="seed of the test scenes (default: from seed)")
-    test_scenes: int = Field(DEFAULT_TEST_SCENES, ge=1, le=200, description="test scenes scored after every signal")
-    test_pool: int = Field(DEFAULT_TEST_POOL, ge=0, le=1000, description="more test scenes, scored at k = K only")
-    new_scene: NewSceneRule = "counted"
-    stop_when_done: bool = Field(False, description="end early when a learner allowed to finish says done (not in benchmarks)")
-    curve: bool = Field(True, description="score after every signal (False: only at k = K)")
-    max_goal_retries: int = Field(1, ge=0, description="re-asks when y cannot be turned into motion")
-    video: str = Field("none", pattern="^(none|final|all)$", description="GIFs written: none, the final test, or all")
-    video_fps: int = 10
+    budget: int = Field(DEFAULT_BUDGET, ge=0, le=100, description="K: signals the user gives; every answer counts")
+    seed: int = Field(0, ge=0, description="Seed of every random choice")
+    test_seed: int | None = Field(None, ge=0, description="Seed of the test scenes (default: from --seed); a bench "
+                                  "record's config.spec.protocol.test_seed replays its episode")
+    test_scenes: int = Field(DEFAULT_TEST_SCENES, ge=1, le=200, description="Test scenes scored after every signal")
+    test_pool: int = Field(DEFAULT_TEST_POOL, ge=0, le=1000, description="More test scenes, scored after the last "
+                           "signal (k = K)")
+    new_scene: NewSceneRule = Field("counted", description="counted (every answer is a signal) | free (old rule, ≤3 "
+                                    "uncounted) | off")
+    stop_when_done: bool = Field(False, description="End early when a learner allowed to finish says done (not in "
+                                 "benchmarks)")
+    curve: bool = Field(True, description="Score after every signal (off: only at k = K; for slow models)")
+    max_goal_retries: int = Field(1, ge=0, description="Re-asks when y cannot be turned into motion")
+    video: str = Field("none", pattern="^(none|final|all)$", description="GIFs written: none | final | all")
+    video_fps: int = Field(10, ge=1, description="Frames per second of the GIFs")
 
     @cached_property
     def seeds(self) -> EpisodeSeeds:
@@ -85,50 +88,39 @@ class ModelsConfig(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    llm: str = "embedded"
-    vlm: str | None = None
-    base_url: str | None = None
-    cache: str | None = None
-    cache_mode: str = Field("record", pattern="^(record|replay|off)$")
+    llm: str = Field("embedded", description="LLM: embedded | gguf:/path.gguf | openai:<model> | none (Bayesian methods "
+                     "and baselines)")
+    vlm: str | None = Field(None, description="Multimodal model spec for the retriever (default: the LLM)")
+    base_url: str | None = Field(None, description="OpenAI-compatible endpoint",
+                                 json_schema_extra={"envvar": "OPENAI_BASE_URL"})
+    cache: str | None = Field(None, description="Response cache file (SQLite); default ~/.cache/activeintent")
+    cache_mode: str = Field("record", pattern="^(record|replay|off)$", description="record | replay | off")
 
 
-class LearnerConfig(BaseModel):
-    """The method and the settings the methods read (each method reads the ones it has)."""
+class LearnerSpec(BaseModel):
+    """The method and its settings. The settings are the method's own: its config class
+    (``Method.settings``) validates them when the spec is checked (runner.check_spec) and a
+    checked spec holds all of them, defaults included, as the episode ran."""
 
     model_config = ConfigDict(extra="forbid")
 
-    method: str = DEFAULT_METHOD
-    prior: str | None = Field(None, pattern="^(length|uniform|fitted|file:.+)$",
-                              description="length | uniform | fitted (lang-* only) | file:PATH (lang-*, from `prior fit`) | "
-                              "None: the method's own (lang-*: fitted, the others: length)")
-    scenes: str = Field("sampled", description="bayes-* and lang-*: how query scenes are chosen, a name of "
-                        "SCENE_DESIGNS (sampled | belief | a plug-in's)")
-    language: int = Field(LATEST, description="lang-*: the goal language's version (recorded, so that an episode "
-                          "run before the language grew replays in its own)")
-    epsilon: float = Field(2.0, ge=0, description="ε: seconds before the stop for image I_b")
-    early_threshold: float | None = Field(2.0, ge=0, description="eq. 3: a stop earlier than this shows no I_b (None: ε)")
-    variant: str = Field("faithful", description="the paper's methods: faithful (as the paper ran them) | structured")
-    design_scenes: bool = True
-    retriever: str = Field("symbolic", pattern="^(symbolic|vision)$")
-    executor: str = "plan"
+    method: str = Field(DEFAULT_METHOD, description="Learner (see `activeintent methods`)")
+    settings: dict[str, Any] = Field(default_factory=dict)
 
-    @field_validator("variant")
-    @classmethod
-    def _known_variant(cls, v: str) -> str:
-        if v not in VARIANTS:
-            raise ValueError(f"Unknown variant {v!r}; valid variants: {', '.join(VARIANTS)}.")
-        return v
 
-    @field_validator("language")
-    @classmethod
-    def _known_language(cls, v: int) -> int:
-        return check_language(v)
+class ActConfig(BaseModel):
+    """How y becomes motion."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    executor: str = Field("plan", description="y → plan: parse | plan | cap")
 
 
 class EnvConfig(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
-    name: str = "pybullet"
+    name: str = Field("pybullet", description="Where plans run: pybullet | symbolic",
+                      json_schema_extra={"option": "env"})
 
 
 class UserConfig(BaseModel):
@@ -136,9 +128,13 @@ class UserConfig(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    preset: str = "human"
-    intention: str | None = None
-    intention_file: str | None = Field(None, description="path.py:NAME")
+    preset: str = Field("human", description="Simulated-user preset: human | paper | exact (see docs/protocol.md)",
+                        json_schema_extra={"option": "user"})
+    intention: str | None = Field(None, description="Hidden intention (see `activeintent intentions`)")
+    intention_file: str | None = Field(None, description="Your own intention: path.py:NAME")
+
+
+SECTIONS = ("protocol", "models", "learner", "act", "env", "user")
 
 
 class RunSpec(BaseModel):
@@ -148,29 +144,36 @@ class RunSpec(BaseModel):
 
     protocol: ProtocolConfig = Field(default_factory=lambda: ProtocolConfig(video="final"))
     models: ModelsConfig = Field(default_factory=ModelsConfig)
-    learner: LearnerConfig = Field(default_factory=LearnerConfig)
+    learner: LearnerSpec = Field(default_factory=LearnerSpec)
+    act: ActConfig = Field(default_factory=ActConfig)
     env: EnvConfig = Field(default_factory=EnvConfig)
     user: UserConfig = Field(default_factory=UserConfig)
-    plugins: list[str] = Field(default_factory=list, description="Python files that register plug-ins")
+    plugins: list[str] = Field(default_factory=list, description="Python file registering signals, methods, envs… "
+                               "(repeatable)", json_schema_extra={"option": "plugin"})
 
     @classmethod
     def from_options(cls, base: RunSpec | None = None, **values: Any) -> RunSpec:
-        """A spec from flat option names (the CLI's, and earlier formats'), over ``base`` (default:
-        the defaults). A bad value raises ValueError naming the option as the CLI spells it."""
-        unknown = sorted(set(values) - set(OPTIONS))
-        if unknown:
-            raise ValueError(f"unknown option(s) {', '.join(unknown)}; valid options: {', '.join(OPTIONS)}")
+        """A spec from option names (the CLI's: :func:`option_fields`), over ``base`` (default: the
+        defaults). A name that is no section's field is a learner setting (None: not given, the
+        method's own); the method's config class judges it when the spec is checked. A bad value
+        raises ValueError naming the option as the CLI spells it."""
+        routes = option_fields()
         data = (base or cls()).model_dump()
         for name, value in values.items():
-            section, field = OPTIONS[name]
-            if section is None:
-                data[field] = value
+            if name in routes:
+                section, field, _ = routes[name]
+                if section is None:
+                    data[field] = value
+                else:
+                    data[section][field] = value
+            elif value is None:
+                data["learner"]["settings"].pop(name, None)
             else:
-                data[section][field] = value
+                data["learner"]["settings"][name] = value
         try:
             return cls.model_validate(data)
         except ValidationError as err:
-            where = {v: k for k, v in OPTIONS.items()}
+            where = {(section, field): name for name, (section, field, _) in routes.items()}
             msgs = []
             for e in err.errors():
                 loc = e["loc"]
@@ -180,13 +183,15 @@ class RunSpec(BaseModel):
             raise ValueError("; ".join(msgs)) from None
 
     def options(self) -> dict[str, Any]:
-        """The spec in flat option names (what records and bench.json keep as ``options``/``run``)."""
+        """The spec in option names: the sections' fields, then the learner's settings (for
+        display: records keep the spec itself)."""
         data = self.model_dump(mode="json")
-        return {name: (data[field] if section is None else data[section][field])
-                for name, (section, field) in OPTIONS.items()}
+        out = {name: (data[field] if section is None else data[section][field])
+               for name, (section, field, _) in option_fields().items()}
+        return {**out, **data["learner"]["settings"]}
 
     def with_options(self, **values: Any) -> RunSpec:
-        """A copy with some flat options changed (validated)."""
+        """A copy with some options changed (validated)."""
         return RunSpec.from_options(base=self, **values)
 
     @property
@@ -194,39 +199,20 @@ class RunSpec(BaseModel):
         return self.protocol.seeds
 
 
-# Flat option name (CLI, records) → (section, field). The order is the records' order.
-OPTIONS: dict[str, tuple[str | None, str]] = {
-    "method": ("learner", "method"),
-    "intention": ("user", "intention"),
-    "intention_file": ("user", "intention_file"),
-    "plugins": (None, "plugins"),
-    "budget": ("protocol", "budget"),
-    "seed": ("protocol", "seed"),
-    "test_seed": ("protocol", "test_seed"),
-    "test_scenes": ("protocol", "test_scenes"),
-    "test_pool": ("protocol", "test_pool"),
-    "env": ("env", "name"),
-    "user": ("user", "preset"),
-    "new_scene": ("protocol", "new_scene"),
-    "prior": ("learner", "prior"),
-    "scenes": ("learner", "scenes"),
-    "language": ("learner", "language"),
-    "llm": ("models", "llm"),
-    "vlm": ("models", "vlm"),
-    "base_url": ("models", "base_url"),
-    "cache": ("models", "cache"),
-    "cache_mode": ("models", "cache_mode"),
-    "executor": ("learner", "executor"),
-    "retriever": ("learner", "retriever"),
-    "epsilon": ("learner", "epsilon"),
-    "early_threshold": ("learner", "early_threshold"),
-    "variant": ("learner", "variant"),
-    "design_scenes": ("learner", "design_scenes"),
-    "video": ("protocol", "video"),
-    "curve": ("protocol", "curve"),
-    "stop_when_done": ("protocol", "stop_when_done"),
-}
+def option_name(field: str, info: FieldInfo) -> str:
+    """The command line's name of a field: its own, unless it says another (``env``: the env's name)."""
+    extra = info.json_schema_extra
+    return str(extra.get("option", field)) if isinstance(extra, dict) else field
 
-# Options added after results were recorded, with the value those results ran with: a record or a
-# bench.json without the option gets it (bench.work.bench_json, bench.verify.migrated).
-OPTIONS_ADDED = {"scenes": "sampled", "language": 1}
+
+def option_fields() -> dict[str, tuple[str | None, str, FieldInfo]]:
+    """Every section field by its option name → (section, field, its pydantic FieldInfo); the
+    learner's settings are not here (each method's config class has its own)."""
+    out: dict[str, tuple[str | None, str, FieldInfo]] = {}
+    for section in SECTIONS:
+        model = RunSpec.model_fields[section].annotation
+        for field, info in model.model_fields.items():  # type: ignore[union-attr]
+            if (section, field) != ("learner", "settings"):
+                out[option_name(field, info)] = (section, field, info)
+    out[option_name("plugins", RunSpec.model_fields["plugins"])] = (None, "plugins", RunSpec.model_fields["plugins"])
+    return out

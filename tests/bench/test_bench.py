@@ -24,7 +24,7 @@ from activeintent.runner import RunSpec
 ROOT = Path(__file__).resolve().parents[2]
 METHODS = ["bayes-stop", "zero-signal"]
 INTENTIONS = ["stack", "color-match"]
-PROTOCOL = ("env", "user_preset", "budget", "new_scene", "prior", "test_scenes")
+PROTOCOL = ("env", "budget", "new_scene", "test_scenes", "test_pool")  # and the whole spec: config.spec
 
 
 def tiny(jobs: int = 1, **run) -> BenchConfig:
@@ -100,7 +100,9 @@ def test_tiny_bench_records_the_protocol_and_reports_intervals_and_baselines(tmp
         assert r["format"] == FORMAT_VERSION and all(k in r for k in PROTOCOL)
         assert len(r["success_at"]) == 3 and r["test_scenes"] >= 10
         assert r["signals_used"] == (2 if r["method"] == "bayes-stop" else 0)
-        assert r["user_preset"] == "human" and r["new_scene"] == "counted"
+        spec = r["config"]["spec"]
+        assert spec["user"]["preset"] == "human" and r["new_scene"] == "counted" == spec["protocol"]["new_scene"]
+        assert spec["learner"] == {"method": r["method"], "settings": {"prior": "length", "scenes": "sampled"}}
     report = write_report(records, METHODS, INTENTIONS, tmp_path / "one",
                           {"env": "symbolic", "budget": 2, "trials": 1}).read_text()
     assert "*zero-signal* (baseline)" in report and "(n=1)" in report and "Wilson" in report
@@ -131,7 +133,7 @@ def test_resume_refuses_other_settings(tmp_path):
 def test_a_plugin_signal_runs_in_bench_without_package_changes(tmp_path):
     plugin = str(ROOT / "examples" / "my_signal.py")
     options = BenchConfig(methods=["bayes-rating"], intentions=["stack"], trials=1, seed=1,
-                           run=RunSpec.from_options(budget=3, llm="none", env="symbolic", video="none", plugins=[plugin]))
+                           run=RunSpec.from_options(budget=3, llm="none", env="symbolic", video="none", plugin=[plugin]))
     (r,) = run_bench(options, tmp_path)
     assert r.get("error") is None and r["method"] == "bayes-rating"
     assert r["signals_used"] == 3 and set(r["answers"]) <= {"rating", "new_scene"}

@@ -23,7 +23,7 @@ from activeintent.bench.report import (
 )
 from activeintent.learners.registry import method_names
 
-SETTINGS = {"env": "symbolic", "user_preset": "human", "budget": 2, "trials": 4}
+SETTINGS = {"env": "symbolic", "user": "human", "budget": 2, "trials": 4}
 
 
 def records_of(methods: list[str], intentions=("stack", "align"), trials: int = 4) -> list[dict]:

@@ -45,13 +45,20 @@ def test_records_that_do_not_belong_to_the_folder_are_set_aside_and_reported(tmp
     seed, test_seed = trial_seeds(3, "color-match", 2)
     trial2 = {**real, "trial": 2, "seed": seed, "test_seed": EpisodeSeeds.from_seed(seed, test_seed).test}
     fake_commit = "0123456789" * 4
+
+    def spec_with(section: str, field: str, value) -> dict:
+        spec = {**trial2["config"]["spec"], section: {**trial2["config"]["spec"][section], field: value}}
+        return {**trial2, "config": {**trial2["config"], "spec": spec}}
+
     forged = {  # each wrong in one way only
         "trial 7 of a --trials 3 folder": {**real, "trial": 7},
-        "another env": {**trial2, "env": "pybullet"},
+        "another env": spec_with("env", "name", "pybullet"),
+        "an env its own spec contradicts": {**trial2, "env": "pybullet"},
         "another budget": {**trial2, "budget": 9},
-        "another user preset": {**trial2, "user_preset": "exact"},
-        "another model": {**trial2, "llm": "openai:qwen"},
-        "another executor": {**trial2, "executor": "cap"},
+        "another user preset": spec_with("user", "preset", "exact"),
+        "another model": spec_with("models", "llm", "openai:qwen"),
+        "another executor": spec_with("act", "executor", "cap"),
+        "another prior": spec_with("learner", "settings", {"prior": "uniform", "scenes": "sampled"}),
         "another method": {**trial2, "method": "bayes-stop"},
         "another trial's seeds": {**real, "trial": 2},
         "a false provenance": {**trial2, "provenance": {**real["provenance"], "commit": fake_commit}},
@@ -65,12 +72,15 @@ def test_records_that_do_not_belong_to_the_folder_are_set_aside_and_reported(tmp
     assert f"{len(forged)} line(s) of results.jsonl not trusted" in text
     kept = lines(results)
     assert sorted(r["trial"] for r in kept) == [0, 1, 2]  # trial 2 really run, n = 3
-    assert all(r["env"] == "symbolic" and r["llm"] == "none" and r["format"] == 3 for r in kept)
+    assert all(r["env"] == "symbolic" and r["config"]["spec"]["models"]["llm"] == "none" and r["format"] == 3
+               for r in kept)
     aside = lines(tmp_path / "rejected.jsonl")
     assert len(aside) == len(forged)
     reasons = [r["reason"] for r in aside]
-    for why, expect in zip(reasons, ["trial 7 is past", "env 'pybullet'", "budget 9", "user_preset 'exact'",
-                                     "llm 'openai:qwen'", "executor 'cap'", "method 'bayes-stop'", "seed ",
+    for why, expect in zip(reasons, ["trial 7 is past", "env.name 'pybullet'", "env 'pybullet' (its spec's 'symbolic')",
+                                     "budget 9", "user.preset 'exact'", "models.llm 'openai:qwen'",
+                                     "act.executor 'cap'", "learner.settings.prior 'uniform'",
+                                     "method 'bayes-stop'", "seed ",
                                      "not in this checkout's history", "format 99", "curve's last value"], strict=True):
         assert expect in why, (expect, why)
     report = " ".join((tmp_path / "report.md").read_text().split())

@@ -15,6 +15,7 @@ from activeintent.bench.verify import NOT_VERIFIED, StaleFolder, differences, sa
 from activeintent.bench.work import read_bench_config
 from activeintent.protocol import FORMAT_VERSION
 from activeintent.results import load_results, read_results
+from activeintent.spec import RunSpec
 
 RESULTS = Path(__file__).resolve().parents[2] / "docs" / "results"
 PAPER = RESULTS / "paper"
@@ -82,14 +83,17 @@ def test_all_means_every_committed_folder_headline_and_experiments():
 
 
 def test_records_of_older_options_are_read_with_the_value_they_ran_with():
-    from activeintent.bench.verify import migrated
+    from activeintent.bench.legacy import migrated
 
-    old = {"success": 1.0, "config": {"options": {"method": "lang-stop", "plugins": ["examples/x.py"]}}}
-    new = {"success": 1.0, "config": {"options": {"method": "lang-stop", "scenes": "sampled",
-                                                  "plugins": ["experiments/x/x.py"]}}}
-    assert differences(migrated(old), migrated(new)) == {}
-    belief = {**new, "config": {"options": {**new["config"]["options"], "scenes": "belief"}}}
-    assert set(differences(migrated(old), migrated(belief))) == {"config.options.scenes"}
+    old = {"success": 1.0, "prior": "length", "variant": "faithful",
+           "config": {"options": {"method": "lang-stop", "prior": "fitted", "epsilon": 2.0,
+                                  "plugins": ["examples/x.py"]}}}
+    spec = RunSpec.from_options(method="lang-stop", prior="fitted", scenes="sampled", language=1)
+    new = {"success": 1.0, "config": {"spec": spec.model_dump(mode="json", exclude={"plugins"})}}
+    assert differences(migrated(old), migrated(new)) == {}  # the old shape read as the new
+    belief = {**new, "config": {"spec": spec.with_options(scenes="belief").model_dump(mode="json", exclude={"plugins"})}}
+    assert set(differences(migrated(old), migrated(belief))) == {"config.spec.learner.settings.scenes"}
+    assert migrated(new) == new
 
 
 def test_the_sample_covers_every_method_before_any_twice():

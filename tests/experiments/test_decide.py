@@ -33,8 +33,9 @@ DECIDE, LangLearner = decide.DECIDE, decide.DecideLearner
 
 
 def LangConfig(**settings):  # noqa: N802 - stands for the config class
-    """decide's settings in language 1 of the goal language, where its findings were measured."""
-    return decide.DecideConfig(**{"language": 1, **settings})
+    """decide's settings in language 1 of the goal language, under the length prior: where its findings
+    were measured."""
+    return decide.DecideConfig(**{"language": 1, "prior": "length", **settings})
 
 RED_ON_BLUE = "every colour:red on-the-block:blue"
 OTHERS = ["form tower:any all:", "every all: in-bowl:any", "form row:any all:", "every colour:green on-table:"]
@@ -248,12 +249,12 @@ def test_decide_records_what_each_answer_taught():
 
 
 def test_the_bench_reads_the_belief_on_a_hidden_goal_without_telling_the_learner():
-    from activeintent.runner import RunSpec, build_episode
+    from activeintent.runner import RunSpec, build_episode, for_method
 
     options = RunSpec.from_options(method="decide-stop", intention="truth-03", env="symbolic", llm="none", video="none",
                          budget=2, seed=1, test_scenes=1, test_pool=0, prior="length",
                          language=1)  # decide's findings' settings; the truth goals are language 1's
-    assert options.learner.language == 1
+    assert options.learner.settings["language"] == 1
     episode = build_episode(options)
     key = episode.intention.goal.key
     prior = episode.learner.mass_of(key)
@@ -261,7 +262,7 @@ def test_the_bench_reads_the_belief_on_a_hidden_goal_without_telling_the_learner
     bits = episode.run().diagnostics["truth_bits"]
     assert len(bits) == 3 and bits[0] == pytest.approx(-np.log2(prior), abs=1e-4)
     assert bits[-1] == pytest.approx(-np.log2(episode.learner.mass_of(key)), abs=1e-4)
-    plain = build_episode(options.with_options(method="bayes-stop")).run()
+    plain = build_episode(for_method(options, "bayes-stop")).run()
     assert "truth_bits" not in plain.diagnostics
 
 

@@ -10,7 +10,7 @@ import pytest
 
 from activeintent.registry import load_plugin
 from activeintent.results import read_results
-from activeintent.runner import build_episode
+from activeintent.runner import build_episode, for_method
 from activeintent.spec import RunSpec
 
 EXPERIMENTS = Path(__file__).resolve().parents[2] / "experiments"
@@ -43,10 +43,10 @@ def test_every_experiment_file_is_run_here():
 @pytest.mark.parametrize("plugin", sorted(EPISODES))
 def test_the_experiment_runs_one_episode(plugin, tmp_path):
     method, intention, intention_file = EPISODES[plugin]
-    spec = RunSpec.from_options(method=method, intention=intention, intention_file=intention_file,
-                                plugins=[str(EXPERIMENTS / plugin)], env="symbolic", llm="none", budget=2,
-                                test_scenes=3, test_pool=0, video="none", seed=1,
-                                language=1, prior="length")  # what the findings were measured in
+    spec = for_method(RunSpec.from_options(intention=intention, intention_file=intention_file,
+                                           plugin=[str(EXPERIMENTS / plugin)], env="symbolic", llm="none", budget=2,
+                                           test_scenes=3, test_pool=0, video="none", seed=1,
+                                           language=1, prior="length"), method)  # what the findings were measured in
     result = build_episode(spec, tmp_path).run()
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["method"] == method and summary["signals_used"] == 2
@@ -56,13 +56,13 @@ def test_the_experiment_runs_one_episode(plugin, tmp_path):
 def test_the_clairvoyant_bound_replays_a_decide_stop_record(tmp_path):
     """The diagnostic re-runs a recorded decide-stop episode of exact users with its chooser."""
     bound = load_plugin(EXPERIMENTS / "decide" / "clairvoyant_bound.py")
-    spec = RunSpec.from_options(method="decide-stop", intention="color-match", plugins=[str(EXPERIMENTS / "decide" / "learner.py")],
+    spec = RunSpec.from_options(method="decide-stop", intention="color-match", plugin=[str(EXPERIMENTS / "decide" / "learner.py")],
                                 env="symbolic", llm="none", budget=2, test_scenes=3, test_pool=0, video="none",
                                 user="exact", seed=2)
     build_episode(spec, tmp_path).run()
     summary = json.loads((tmp_path / "summary.json").read_text())
     record = {"intention": "color-match", "seed": 2, "method": "decide-stop", "success_at": summary["success_at"],
-              "config": {"episode": spec.protocol.model_dump(), "options": spec.options()}}
+              "config": summary["config"]}
     row = bound.run_one(record)
     assert len(row["success_at"]) == 3 and row["baseline_success_at"] == summary["success_at"]
 
@@ -98,12 +98,12 @@ def test_the_defaults_comparison_pairs_arms_and_applies_the_rule(tmp_path):
 
 @pytest.mark.parametrize("plugin", sorted(DESIGNS))
 def test_the_scene_design_runs_one_episode(plugin, tmp_path):
-    spec = RunSpec.from_options(method="lang-stop", intention="stack", plugins=[str(EXPERIMENTS / plugin)],
+    spec = RunSpec.from_options(method="lang-stop", intention="stack", plugin=[str(EXPERIMENTS / plugin)],
                                 scenes=DESIGNS[plugin], env="symbolic", llm="none", budget=3, test_scenes=3,
                                 test_pool=0, video="none", seed=1, language=1)
     build_episode(spec, tmp_path).run()
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert summary["config"]["options"]["scenes"] == DESIGNS[plugin] and summary["signals_used"] == 3
+    assert summary["config"]["spec"]["learner"]["settings"]["scenes"] == DESIGNS[plugin] and summary["signals_used"] == 3
 
 
 def test_answered_scenes_ask_again_on_answered_tables_and_not_on_refused_ones():

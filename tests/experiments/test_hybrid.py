@@ -24,7 +24,7 @@ HybridLearner = load_plugin(PLUGIN).HybridLearner
 def rounds_of(method: str, out: Path, signal_seed: int = 4) -> list[dict]:
     spec = RunSpec.from_options(method=method, intention="dev-warm-on-cool", env="symbolic", llm="none",
                                 video="none", budget=3, seed=signal_seed, test_scenes=1, curve=False,
-                                user="human", plugins=[PLUGIN])
+                                user="human", plugin=[PLUGIN])
     build_episode(spec, out).run()
     return [{"scene": r["scene"], "plans": r["plans"], "answer": r["answer"]} for r in read_rounds(out / "rounds.jsonl")]
 

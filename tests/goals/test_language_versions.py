@@ -43,17 +43,18 @@ def test_each_language_s_length_prior_sums_to_one_over_its_clauses(version):
 
 
 def test_a_record_written_before_the_language_grew_replays_in_language_1():
-    from activeintent.bench.verify import migrated
+    from activeintent.bench.legacy import migrated
     from activeintent.bench.work import read_bench_config
+    from activeintent.runner import check_spec
     from activeintent.spec import RunSpec
 
     old = {"config": {"options": {"method": "lang-stop", "prior": "length"}}}
-    assert migrated(old)["config"]["options"]["language"] == 1
+    assert migrated(old)["config"]["spec"]["learner"]["settings"]["language"] == 1
     folder = read_bench_config(Path(__file__).resolve().parents[2] / "docs" / "results" / "heldout-freeze" / "bench.json")
-    assert folder.run.learner.language == 1  # its bench.json predates the field
-    assert RunSpec().options()["language"] == LATEST
+    assert folder.run.learner.settings["language"] == 1  # its bench.json predates the field
+    assert check_spec(RunSpec.from_options(method="lang-stop", llm="none")).learner.settings["language"] == LATEST
     with pytest.raises(ValueError, match="unknown language version 7"):
-        RunSpec.from_options(language=7)
+        check_spec(RunSpec.from_options(method="lang-stop", llm="none", language=7))
 
 
 def test_a_language_1_learner_never_admits_a_goal_of_language_2():

@@ -121,19 +121,21 @@ def test_a_fitted_prior_is_refused_for_learners_outside_the_goal_language():
     from activeintent.runner import check_spec
     from activeintent.spec import RunSpec
 
-    with pytest.raises(ValueError, match="goal language"):
+    with pytest.raises(ValueError, match="--prior: Input should be 'length' or 'uniform'"):
         check_spec(RunSpec.from_options(method="bayes-stop", prior="fitted", llm="none", env="symbolic"))
     check_spec(RunSpec.from_options(method="lang-stop", prior="fitted", llm="none", env="symbolic"))
 
 
 def test_each_method_takes_its_own_prior_when_none_is_given_and_the_record_keeps_it():
-    from activeintent.runner import build_episode, with_method_defaults
+    from activeintent.runner import build_episode, check_spec
     from activeintent.spec import RunSpec
 
-    assert RunSpec().learner.prior is None
-    assert with_method_defaults(RunSpec.from_options(method="lang-stop")).learner.prior == "fitted"
-    assert with_method_defaults(RunSpec.from_options(method="lang-zero-signal")).learner.prior == "fitted"
-    assert with_method_defaults(RunSpec.from_options(method="bayes-stop")).learner.prior == "length"
-    assert with_method_defaults(RunSpec.from_options(method="lang-stop", prior="length")).learner.prior == "length"
+    def prior(**options):
+        return check_spec(RunSpec.from_options(llm="none", **options)).learner.settings["prior"]
+
+    assert "prior" not in RunSpec().learner.settings
+    assert prior(method="lang-stop") == prior(method="lang-zero-signal") == "fitted"
+    assert prior(method="bayes-stop") == "length"
+    assert prior(method="lang-stop", prior="length") == "length"
     episode = build_episode(RunSpec.from_options(method="bayes-stop", env="symbolic", llm="none", video="none", budget=1))
-    assert episode.extra_config["options"]["prior"] == "length"  # what ran, not "the method's own"
+    assert episode.extra_config["spec"]["learner"]["settings"]["prior"] == "length"  # what ran, not "the method's own"

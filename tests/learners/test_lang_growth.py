@@ -223,7 +223,7 @@ def test_a_new_lang_learner_forgets_the_planner_failures_marked_in_the_shared_sp
     some = next(iter(scenes))
     assert not shared.feasible(some)[::2].any()  # the marks are in effect before the learner is built
 
-    learner = LangLearner("stop")
+    learner = LangLearner("stop", config=LangConfig(prior="length"))
     assert learner.base == [shared]
     for objects in scenes:
         assert (learner.judge.feasible(objects) == shared.compiled.possible(objects)).all()

@@ -30,6 +30,7 @@ from activeintent.learners.paper.retrievers import (
 from activeintent.learners.paper.structured import (
     MllmLlmLearner,
     PaperLearnerConfig,
+    PaperSettings,
     failure_reason,
 )
 from activeintent.learners.registry import LearnerContext, get_method
@@ -39,7 +40,6 @@ from activeintent.records import read_rounds
 from activeintent.runner import RunSpec, build_episode
 from activeintent.signals.preference import PreferenceAnswer
 from activeintent.signals.stop import StopAnswer
-from activeintent.spec import LearnerConfig
 from activeintent.world import PutIn, PutOn, Scene, WorldState, describe_skill, layout
 from helpers import kinematic_trajectory
 
@@ -235,9 +235,9 @@ def test_failure_text_is_said_once_and_test_scene_failures_stay_out_of_the_memor
 def test_variant_is_chosen_by_the_context():
     model = ScriptedModel(respond=respond)
     assert get_method("mllm")(LearnerContext(llm=model)).variant == "faithful"
-    assert get_method("mllm")(LearnerContext(llm=model, config=LearnerConfig(variant="structured"))).variant == "structured"
+    assert get_method("mllm")(LearnerContext(llm=model, settings=PaperSettings(variant="structured"))).variant == "structured"
     with pytest.raises(ValueError, match="valid variants: faithful, structured"):
-        LearnerConfig(variant="fancy")  # refused with the spec, before any learner is built
+        PaperSettings(variant="fancy")  # refused with the spec, before any learner is built
 
 
 # -- end to end, through a real HTTP server ------------------------------------------------------
@@ -358,9 +358,7 @@ def test_resuming_a_folder_made_before_variants_existed(tmp_path):
 
     old = BenchConfig(methods=["bayes-stop"], intentions=["stack"], run=RunSpec.from_options(video="none"))
     data = json.loads(old.model_dump_json())
-    data["run"] = old.run.options()  # format 1: flat option names, without the options added since
-    for key in ("variant", "early_threshold"):
-        data["run"].pop(key)
+    data["run"] = {k: v for k, v in old.run.options().items() if k != "plugin"}  # format 1: flat option names
     (tmp_path / "bench.json").write_text(json.dumps(data))
     _check_same_settings(old, tmp_path / "bench.json")  # Bayesian methods have no variant: same settings
     data["methods"] = ["mllm"]

@@ -15,7 +15,7 @@ from activeintent.learners.lang.hypotheses import LangSpace
 from activeintent.learners.lang.learner import LangConfig, LangLearner
 from activeintent.learners.registry import LearnerContext, get_method
 from activeintent.runner import build_episode, check_spec
-from activeintent.spec import LearnerConfig, RunSpec
+from activeintent.spec import RunSpec
 
 RED_ON_BLUE = "every colour:red on-the-block:blue"
 OTHERS = ["form tower:any all:", "every all: in-bowl:any", "form row:any all:", "every colour:green on-table:"]
@@ -45,8 +45,9 @@ def test_belief_scenes_can_show_what_the_belief_expects_sampled_ones_mostly_cann
 def test_belief_scenes_also_follow_a_new_scene_answer_sampled_ones_do_not():
     assert {"sampled", "belief"} <= set(SCENE_DESIGNS)  # a plug-in loaded by another test may add its own
     for method in ("lang-stop", "bayes-preference"):
-        assert get_method(method)(LearnerContext(config=LearnerConfig(method=method, scenes="belief"))).redesigns_after_new_scene
-        assert not get_method(method)(LearnerContext(config=LearnerConfig(method=method))).redesigns_after_new_scene
+        settings = get_method(method).settings
+        assert get_method(method)(LearnerContext(settings=settings(scenes="belief"))).redesigns_after_new_scene
+        assert not get_method(method)(LearnerContext(settings=settings())).redesigns_after_new_scene
 
 
 def test_the_spec_records_which_design_ran(tmp_path):
@@ -54,7 +55,7 @@ def test_the_spec_records_which_design_ran(tmp_path):
                                 test_scenes=3, test_pool=0, video="none", scenes="belief")
     build_episode(spec, tmp_path).run()
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert summary["config"]["options"]["scenes"] == "belief"
+    assert summary["config"]["spec"]["learner"]["settings"]["scenes"] == "belief"
     with pytest.raises(ValueError, match="Unknown scene design 'clever'; valid scene designs: sampled, belief"):
         check_spec(RunSpec.from_options(scenes="clever"))
     with pytest.raises(ValueError, match="Unknown scene design"):

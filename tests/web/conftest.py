@@ -14,7 +14,7 @@ import httpx
 import pytest
 
 from activeintent.learners.registry import get_method
-from activeintent.spec import OPTIONS, RunSpec
+from activeintent.spec import RunSpec, option_fields
 from activeintent.web.limits import Limits, SessionLimits
 from activeintent.web.server import create_app, runner_builder
 from activeintent.web.session import SessionManager, StudyConfig
@@ -72,7 +72,7 @@ def _free_port() -> int:
 def study_config(method: str, budget: int, out: Path, **fields) -> StudyConfig:
     """A study of ``method`` (Bayesian methods: no model; 2 test scenes); ``fields`` are the
     spec's options (e.g. intention) or the study's own (e.g. show_estimate)."""
-    run = {k: fields.pop(k) for k in list(fields) if k in OPTIONS}
+    run = {k: fields.pop(k) for k in list(fields) if k in option_fields()}
     spec = RunSpec.from_options(method=method, budget=budget, llm="none", test_scenes=2, **run)
     return StudyConfig(run=spec, signal=get_method(method).signal, out_dir=out, **fields)
 

@@ -14,7 +14,7 @@ import os
 from collections.abc import Iterator
 from pathlib import Path
 
-from activeintent.bench.work import BenchConfig, WorkItem, protocol_fields, run_item
+from activeintent.bench.work import BenchConfig, WorkItem, run_item
 
 BACKENDS = ("local", "ray")
 
@@ -42,8 +42,7 @@ def check_backend(name: str) -> None:
 
 def worker_died(item: WorkItem, options: BenchConfig, why: str = "worker process died") -> dict:
     """The record of an episode whose worker ended without an answer (e.g. a native crash)."""
-    return {"method": item.method, "intention": item.intention, "trial": item.trial,
-            **protocol_fields(options.run), "success": None, "error": why}
+    return {"method": item.method, "intention": item.intention, "trial": item.trial, "success": None, "error": why}
 
 
 def forwarded_env() -> dict[str, str]:

@@ -2,11 +2,10 @@
 ``bench.json`` (the plan) and against itself, cheaply (no episode is run).
 
 - *Planned*: its method, intention and trial are among the bench's (trial < trials).
-- *As planned*: the settings every line records (env, user preset, budget, new-scene rule,
-  prior, test scenes and pool, models, executor, retriever, variant: ``protocol_fields``)
-  equal the folder's, and its seeds are the ones its trial gets (``trial_seeds``; the test seed as the
+- *As planned*: the spec the line records (``config.spec``: protocol, models, the method's
+  settings, executor, env, user preset) equals the one the folder gives its method, and its seeds are the ones its trial gets (``trial_seeds``; the test seed as the
   episode records it, its test-scene stream).
-- *Consistent*: its format is one this code reads (older formats are migrated on read, never
+- *Consistent*: its format is one this code reads (older shapes are read by bench/legacy.py, never
   rewritten), its success equals the last value of its own success@k curve and the curve has
   K + 1 points, and its provenance has the shape ``provenance.py`` writes (a 40-hex commit
   that this checkout knows, when it is a full git checkout; a past date).
@@ -22,9 +21,11 @@ import subprocess
 from functools import cache
 from pathlib import Path
 
-from activeintent.bench.work import BenchConfig, protocol_fields
+from activeintent.bench.legacy import migrated
+from activeintent.bench.work import BenchConfig
 from activeintent.protocol import FORMAT_VERSION, trial_seeds
-from activeintent.runner import with_method_defaults
+from activeintent.registry import load_plugin
+from activeintent.runner import check_spec, for_method
 from activeintent.spec import EpisodeSeeds
 
 _HEX40 = re.compile(r"[0-9a-f]{40}")
@@ -32,15 +33,24 @@ _MISSING = object()
 _FUTURE_SLACK = dt.timedelta(days=1)  # clocks of the machines that made a folder may be off
 
 
-def migrate(record: dict) -> dict:
-    """A record of an older format as the current format's fields (a copy; for checking only):
-    format 2 had no test pool (scored at k = K on the curve's scenes only: test_pool 0)."""
-    fmt = record.get("format")
-    if isinstance(fmt, int) and fmt < 3:
-        record = {**record}
-        if record.get("test_pool") is None:
-            record["test_pool"] = 0
-    return record
+# What each episode of a folder has of its own (checked against its trial apart).
+PER_EPISODE = frozenset({"protocol.seed", "protocol.test_seed", "user.intention", "user.intention_file",
+                         "learner.method"})
+
+
+# A result's own copies of its spec's fields: they must agree with it.
+SPEC_COPIES = {"env": "env.name", "budget": "protocol.budget", "new_scene": "protocol.new_scene",
+               "test_scenes": "protocol.test_scenes", "test_pool": "protocol.test_pool"}
+
+
+def _flat(data: dict, prefix: str = "") -> dict[str, object]:
+    out: dict[str, object] = {}
+    for key, value in data.items():
+        if isinstance(value, dict) and value:
+            out.update(_flat(value, f"{prefix}{key}."))
+        else:
+            out[f"{prefix}{key}"] = value
+    return out
 
 
 class Plan:
@@ -53,14 +63,25 @@ class Plan:
         self.seed = options.seed
         self.budget = options.run.protocol.budget
         self.run = options.run
-        self._fields: dict[str, dict] = {}
+        self._specs: dict[str, dict | None] = {}
+        for path in options.run.plugins:  # its methods' settings say how its lines read (bench/legacy.py)
+            try:
+                load_plugin(path)
+            except (OSError, ValueError):
+                pass  # lines of its methods are then checked without their settings
 
-    def fields(self, method: str) -> dict:
-        """The settings a line of ``method`` records (its own prior where the folder leaves it open)."""
-        got = self._fields.get(method)
-        if got is None:
-            got = self._fields[method] = protocol_fields(with_method_defaults(self.run.with_options(method=method)))
-        return got
+    def spec(self, method: str) -> dict[str, object] | None:
+        """The spec a line of ``method`` records, flat ('learner.settings.prior': …) and without
+        what each episode has of its own (seeds, intention); None when it cannot be known here (a
+        plug-in's method whose file is not at hand)."""
+        if method not in self._specs:
+            try:
+                spec = check_spec(for_method(self.run, method)).model_dump(mode="json", exclude={"plugins"})
+            except (ValueError, OSError):
+                self._specs[method] = None
+            else:
+                self._specs[method] = {k: v for k, v in _flat(spec).items() if k not in PER_EPISODE}
+        return self._specs[method]
 
     def __call__(self, record: dict) -> tuple[str, str] | None:
         return self.problem(record)
@@ -69,7 +90,7 @@ class Plan:
         fmt = record.get("format")
         if not isinstance(fmt, int) or not 1 <= fmt <= FORMAT_VERSION:
             return "inconsistent", f"format {fmt!r}: this code writes format {FORMAT_VERSION} and reads 1 to {FORMAT_VERSION}"
-        rec = migrate(record)
+        rec = migrated(record)
         m, i, t = rec["method"], rec["intention"], rec["trial"]
         if m not in self.methods:
             return "plan", f"method {m!r} is not one of this folder's ({', '.join(sorted(self.methods))})"
@@ -77,10 +98,15 @@ class Plan:
             return "plan", f"intention {i!r} is not one of this folder's"
         if t >= self.trials:
             return "plan", f"trial {t} is past this folder's {self.trials} trial(s) (0 to {self.trials - 1})"
-        changed = [f"{k} {rec.get(k, '(missing)')!r} (planned {v!r})"
-                   for k, v in self.fields(m).items() if rec.get(k, _MISSING) != v]
-        if changed:
-            return "plan", "not made with this folder's settings: " + "; ".join(changed)
+        planned, config = self.spec(m), rec.get("config")
+        if planned is not None and isinstance(config, dict) and isinstance(config.get("spec"), dict):
+            got = _flat(config["spec"])
+            changed = [f"{k} {got.get(k, '(missing)')!r} (planned {v!r})" for k, v in planned.items()
+                       if got.get(k, _MISSING) != v]
+            changed += [f"{k} {rec[k]!r} (its spec's {got.get(path)!r})" for k, path in SPEC_COPIES.items()
+                        if k in rec and rec[k] != got.get(path)]
+            if changed:
+                return "plan", "not made with this folder's settings: " + "; ".join(changed)
         seed, test_seed = trial_seeds(self.seed, i, t)
         test_seed = _test_stream(test_seed)
         is_error = bool(rec.get("error"))

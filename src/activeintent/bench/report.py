@@ -83,7 +83,7 @@ def protocol_title(intentions: list[str], settings: dict, labels: dict[str, str]
     for i in intentions:
         by[suite_of(i)].append(i)
     suites = ", ".join(_suite_title(s, n, labels) for s, n in by.items()) or "?"
-    parts = [f"suite {suites}", f"user {settings.get('user_preset', '?')}", f"K = {settings.get('budget', '?')} signals",
+    parts = [f"suite {suites}", f"user {settings.get('user', '?')}", f"K = {settings.get('budget', '?')} signals",
              f"{settings.get('trials', '?')} trial{'' if settings.get('trials') == 1 else 's'}",
              f"env {settings.get('env', '?')}"]
     return " · ".join(parts)

@@ -24,19 +24,17 @@ from concurrent.futures.process import BrokenProcessPool
 from multiprocessing import get_context
 from pathlib import Path
 
-from activeintent.bench.backends import execute_ray
+from activeintent.bench.backends import execute_ray, worker_died
 from activeintent.bench.checks import Plan
 from activeintent.bench.verify import differences
 from activeintent.bench.work import (
     BenchConfig,
     WorkItem,
     bench_json,
-    protocol_fields,
     read_bench_config,
     run_item,
     write_bench_config,
 )
-from activeintent.learners.registry import PAPER_METHODS
 from activeintent.protocol import FORMAT_VERSION
 from activeintent.records import dumps
 from activeintent.results import (
@@ -49,6 +47,7 @@ from activeintent.results import (
     rewrite_results,
     set_aside_rejected,
 )
+from activeintent.runner import check_spec, for_method
 
 
 def run_bench(options: BenchConfig, out: Path, on_done: Callable[[dict, int, int], None] | None = None,
@@ -135,22 +134,32 @@ def _planned(options: BenchConfig, path: Path) -> BenchConfig:
                                       "trials": max(options.trials, before.trials)})
 
 
-_SETTINGS = ("seed", "run")  # methods, intentions and trials may grow on resume; these may not change
+def _effective(options: BenchConfig | dict, methods: list[str]) -> dict:
+    """What a folder's episodes are made with: the bench's seed, its spec but the learner's section,
+    and each method's own settings, defaults filled in (a setting given to a benchmark goes to the
+    methods that have it)."""
+    if isinstance(options, dict):
+        options = BenchConfig.model_validate(options)
+    run = options.run.model_dump(mode="json", exclude={"learner", "plugins"})
+    own = {}
+    for m in methods:
+        try:
+            own[m] = check_spec(for_method(options.run, m)).learner.settings
+        except ValueError as err:
+            own[m] = f"({err})"
+    return {"seed": options.seed, "run": run, "settings": own}
 
 
 def _check_same_settings(options: BenchConfig, path: Path) -> None:
     """Resuming into a folder made with other settings would mix incomparable episodes."""
     if not path.exists():
         return
-    before = bench_json(path)  # options added since: the values they had in effect then
-    now = json.loads(options.model_dump_json())
-    if isinstance(before.get("run"), dict):
-        if not any(m in PAPER_METHODS for m in before.get("methods", []) + now["methods"]):
-            for settings in (before, now):  # only the paper's methods have variants
-                settings["run"]["learner"].pop("variant", None)
-    changed = [k for k in _SETTINGS if before.get(k) != now.get(k)]
+    before = bench_json(path)  # an older format: the values it ran with
+    methods = list(dict.fromkeys(before.get("methods", []) + options.methods))
+    then, now = _effective(before, methods), _effective(options, methods)
+    changed = [k for k in then if then[k] != now[k]]
     if changed:
-        diff = "; ".join(f"{k}: {before.get(k)} → {now.get(k)}" for k in changed)
+        diff = "; ".join(f"{k}: {then[k]} → {now[k]}" for k in changed)
         raise ValueError(f"{path.parent} holds results made with other settings ({diff}). "
                          "Use another --out, or the same settings to resume.")
 
@@ -187,8 +196,7 @@ def _execute(todo: list[WorkItem], options: BenchConfig, out: Path) -> Iterator[
                 fut = alone.submit(run_item, item, *args)
                 wait([fut])
                 if isinstance(fut.exception(), BrokenProcessPool):
-                    yield {"method": item.method, "intention": item.intention, "trial": item.trial,
-                           **protocol_fields(options.run), "success": None, "error": "worker process died"}
+                    yield worker_died(item, options)
                 else:
                     yield fut.result()
 

@@ -15,35 +15,23 @@ from __future__ import annotations
 from pathlib import Path
 
 from activeintent.bench.checks import Plan
+from activeintent.bench.legacy import migrated
 from activeintent.bench.work import WorkItem, read_bench_config, run_item
 from activeintent.protocol import FORMAT_VERSION
 from activeintent.results import load_results, read_results
-from activeintent.spec import OPTIONS_ADDED
 
 NOT_VERIFIED = "NOT-VERIFIED.md"  # a folder's own word on why it cannot be re-run
 # Tokens describe what answering cost this run: a re-run whose answers come from the response
 # cache spends none (its model calls and answers are compared).
 NOT_COMPARED = frozenset({"wall_s", "time_split", "provenance", "traceback", "prompt_tokens", "completion_tokens"})
-# Record fields added after format 3 began: compared when the recorded episode has them (an
-# older record cannot differ in a field it never had; every field it has is compared).
-ADDED_IN_FORMAT_3 = frozenset({"diagnostics", "final_scene"})
+# Record fields compared only when the recorded episode has them: an older record cannot differ in a
+# field it never had (diagnostics, final_scene were added within format 3; a line read from the
+# old shape has no retriever, variant of its own: bench/legacy.py).
+COMPARED_WHEN_RECORDED = frozenset({"diagnostics", "final_scene", "retriever", "variant"})
 # Fields whose meaning changed within format 3, compared when the recorded episode has the field
 # that marks the new meaning: final_z / final_goal came from test scene 0 before ``final_scene``
 # (the first scene that can show the intention) was recorded.
 REDEFINED_IN_FORMAT_3 = {"final_z": "final_scene", "final_goal": "final_scene"}
-# Options added within format 3, with the value that records written before them ran with.
-
-
-def migrated(record: dict) -> dict:
-    """A record as this code writes it: options added since it was written get the value it ran
-    with, and the plug-in files are left out (where a method's code was loaded from describes the
-    run, not the episode: experiments moved from examples/ to experiments/)."""
-    options = record.get("config", {}).get("options")
-    if options is None:
-        return record
-    options = {**OPTIONS_ADDED, **options}
-    options.pop("plugins", None)
-    return {**record, "config": {**record["config"], "options": options}}
 
 
 class StaleFolder(ValueError):
@@ -54,7 +42,7 @@ def differences(recorded: dict, again: dict, prefix: str = "") -> dict[str, tupl
     """Fields whose values differ, nested keys joined by '.' (``NOT_COMPARED`` left out)."""
     out: dict[str, tuple] = {}
     for key in sorted(set(recorded) | set(again)):
-        if not prefix and (key in NOT_COMPARED or (key in ADDED_IN_FORMAT_3 and key not in recorded)
+        if not prefix and (key in NOT_COMPARED or (key in COMPARED_WHEN_RECORDED and key not in recorded)
                            or (key in REDEFINED_IN_FORMAT_3 and REDEFINED_IN_FORMAT_3[key] not in recorded)):
             continue
         a, b = recorded.get(key), again.get(key)

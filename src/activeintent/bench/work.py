@@ -9,9 +9,10 @@ from pathlib import Path
 
 from pydantic import BaseModel, Field
 
+from activeintent.bench.legacy import BENCH_FORMAT, bench_json
 from activeintent.protocol import trial_seeds
-from activeintent.runner import build_episode, with_method_defaults
-from activeintent.spec import OPTIONS, OPTIONS_ADDED, RunSpec
+from activeintent.runner import build_episode, for_method
+from activeintent.spec import RunSpec
 
 
 class WorkItem(BaseModel):
@@ -50,41 +51,6 @@ class BenchConfig(BaseModel):
         return [WorkItem(method=m, intention=i, trial=t) for t in range(self.trials) for i in names for m in self.methods]
 
 
-# bench.json's format. 3: ``run`` is a RunSpec (sections). 2: it says its format; ``run`` in flat
-# option names. 1 (no "format"): options added since take the values they had in effect then
-# (legacy_run).
-BENCH_FORMAT = 3
-
-
-def legacy_run(run: dict) -> dict:
-    """Values of options that did not exist when a format-1 folder was made: the paper's methods
-    ran what is now ``--variant structured``, ε was also eq. 3's threshold, and no test pool was
-    scored at k = K."""
-    return {"variant": "structured", "early_threshold": run.get("epsilon", 2.0), "test_pool": 0}
-
-
-def bench_json(path: Path) -> dict:
-    """A folder's bench.json as the current format's fields (a versioned reader: a format-1 file
-    gets the values its options had in effect); ValueError for a format newer than this code."""
-    data = json.loads(Path(path).read_text())
-    version = data.pop("format", 1)
-    if not isinstance(version, int) or version > BENCH_FORMAT:
-        raise ValueError(f"{path} is bench.json format {version!r}; this code reads formats 1 to {BENCH_FORMAT}: "
-                         "update activeintent")
-    run = data.get("run")
-    if version < 3 and isinstance(run, dict):
-        if version == 1:
-            run = {**legacy_run(run), **run}
-        run = {**OPTIONS_ADDED, **run}
-        data["run"] = RunSpec.from_options(**run).model_dump(mode="json")
-    elif isinstance(run, dict):
-        for name, value in OPTIONS_ADDED.items():
-            section, field = OPTIONS[name]
-            if isinstance(run.get(section), dict):
-                run[section].setdefault(field, value)
-    return data
-
-
 def read_bench_config(path: Path) -> BenchConfig:
     """The options a results folder was made with (its bench.json, of any format)."""
     return BenchConfig.model_validate(bench_json(path))
@@ -94,25 +60,14 @@ def write_bench_config(options: BenchConfig, path: Path) -> None:
     path.write_text(json.dumps({"format": BENCH_FORMAT, **json.loads(options.model_dump_json())}, indent=2))
 
 
-def protocol_fields(run: RunSpec) -> dict:
-    """What every results line records about how it was measured."""
-    p, learner = run.protocol, run.learner
-    return {"env": run.env.name, "user_preset": run.user.preset, "budget": p.budget, "new_scene": p.new_scene,
-            "prior": learner.prior or "per method (lang-*: fitted, others: length)", "test_scenes": p.test_scenes, "test_pool": p.test_pool, "llm": run.models.llm,
-            "executor": learner.executor, "vlm": run.models.vlm, "retriever": learner.retriever,
-            "variant": learner.variant}
-
-
 def run_item(item: WorkItem, options: RunSpec, bench_seed: int, out: str, keep: bool) -> dict:
     """One episode in a worker process (own simulator client, own model handles)."""
     user_defined = ".py:" in item.intention
     seed, test_seed = trial_seeds(bench_seed, item.intention, item.trial)
-    run = options.with_options(method=item.method, intention=None if user_defined else item.intention,
-                               intention_file=item.intention if user_defined else None,
-                               seed=seed, test_seed=test_seed)
-
-    run = with_method_defaults(run)  # the prior the method ran with, in every line
-    base = {"method": item.method, "intention": item.intention, "trial": item.trial, **protocol_fields(run)}
+    run = for_method(options, item.method).with_options(
+        intention=None if user_defined else item.intention, intention_file=item.intention if user_defined else None,
+        seed=seed, test_seed=test_seed)
+    base = {"method": item.method, "intention": item.intention, "trial": item.trial}
     try:
         episode = build_episode(run, Path(out) / "episodes" / item.slug if keep else None)
         try:

@@ -5,10 +5,12 @@ from __future__ import annotations
 
 import functools
 import importlib
+import sys
 
 import typer
 
 from activeintent.cli.options import check_only
+from activeintent.registry import load_plugin
 
 app = typer.Typer(
     name="activeintent",
@@ -57,3 +59,17 @@ for _info in app.registered_commands:
     if (_info.name or "") in _MEASURING:
         _info.callback = _checked(_info.callback)
 
+
+
+def main(argv: list[str] | None = None) -> None:
+    """The `activeintent` program: plug-in files named with ``--plugin`` load before the command
+    line is built, so their learners' settings are options too (and shown by ``--help``)."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    for i, arg in enumerate(args):
+        path = args[i + 1] if arg == "--plugin" and i + 1 < len(args) else arg.removeprefix("--plugin=")
+        if path != arg or arg == "--plugin":
+            try:
+                load_plugin(path)
+            except (OSError, ValueError, SyntaxError):
+                pass  # the command reports it, naming the option
+    app(args=args, prog_name="activeintent")

@@ -1,5 +1,5 @@
 """``python -m activeintent.cli``."""
 
-from activeintent.cli import app
+from activeintent.cli import main
 
-app()
+main()

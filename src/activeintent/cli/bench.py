@@ -11,14 +11,15 @@ from activeintent.bench.backends import check_backend
 from activeintent.bench.coverage import EXPRESSIBLE, agreement, coverage_table, oracle_of
 from activeintent.bench.report import plot_success_vs_signals, write_report
 from activeintent.bench.runner import run_bench
-from activeintent.bench.work import BenchConfig, protocol_fields
+from activeintent.bench.work import BenchConfig
 from activeintent.cli import options as opt
-from activeintent.cli.options import D
-from activeintent.goals.language import parse_goal, speaking
+from activeintent.goals.language import LATEST, parse_goal, speaking
 from activeintent.goals.prior import load_prior
+from activeintent.learners.registry import get_method
 from activeintent.progress_lines import Eta, print_line
 from activeintent.registry import load_plugin
-from activeintent.runner import check_spec
+from activeintent.runner import check_spec, for_method
+from activeintent.spec import RunSpec
 from activeintent.suites import is_held_out, resolve, suite_of
 from activeintent.suites import suite as suite_names
 
@@ -37,7 +38,21 @@ def _split(text: str) -> list[str]:
 PRESETS = {"table1": {"methods": ["preference", "mllm", "mllm-llm"], "suite": "paper", "trials": 5, "budget": 5}}
 
 
-def _apply_preset(preset: str, methods: str, intentions: str, budget: int) -> tuple[str, str, int]:
+# What each episode of a benchmark gets from its item (method, intention, trial), not from options.
+BENCH_SETS = ("method", "intention", "intention_file", "seed", "test_seed", "video", "video_fps", "stop_when_done")
+
+
+def _settings_shown(run: RunSpec, methods: list[str]) -> dict[str, str]:
+    """Each learner setting as the methods ran with it: one value, or each method's."""
+    by_name: dict[str, dict[str, object]] = {}
+    for m in methods:
+        for name, value in check_spec(for_method(run, m)).learner.settings.items():
+            by_name.setdefault(name, {})[m] = value
+    return {name: (str(next(iter(values.values()))) if len(set(map(str, values.values()))) == 1
+                   else ", ".join(f"{m}: {v}" for m, v in values.items())) for name, values in by_name.items()}
+
+
+def _apply_preset(preset: str, methods: str, intentions: str, budget: int | None) -> tuple[str, str, int]:
     """(methods, suite, trials) of the preset; options that would change what it measures are refused."""
     if preset not in PRESETS:
         raise ValueError(f"unknown preset {preset!r}; valid presets: {', '.join(PRESETS)}")
@@ -46,39 +61,21 @@ def _apply_preset(preset: str, methods: str, intentions: str, budget: int) -> tu
         raise ValueError(f"--preset {preset} runs the methods {', '.join(p['methods'])}; drop --methods")
     if intentions:
         raise ValueError(f"--preset {preset} runs the {p['suite']} suite; drop --intentions")
-    if budget != p["budget"]:
+    if budget not in (None, p["budget"]):
         raise ValueError(f"--preset {preset} gives K = {p['budget']} signals; drop --budget")
     return ",".join(p["methods"]), p["suite"], p["trials"]
 
 
+@opt.spec_command(exclude=BENCH_SETS)
 def bench(
+    given: dict,
     methods: Annotated[str, typer.Option("--methods", help="Comma-separated methods (default: bayes-preference, bayes-stop and the baselines)")] = "",
     suite: Annotated[str | None, typer.Option("--suite", help="Comma-separated suites: paper, library, heldout, heldout2, dev, truth-goals (default: paper, unless --intentions or --intention-file name what to run)")] = None,
     intentions: Annotated[str, typer.Option("--intentions", help="Comma-separated intentions (instead of --suite)")] = "",
     intention_file: Annotated[list[str] | None, typer.Option("--intention-file", help="Your own: path.py:NAME (repeatable); alone it runs just these, with --suite or --intentions it adds them")] = None,
-    plugin: opt.Plugin = None,
     preset: Annotated[str | None, typer.Option("--preset", help="table1: the paper's Table 1 (preference, mllm, mllm-llm; the paper's four intentions; 5 trials; K = 5)")] = None,
     trials: Annotated[int | None, typer.Option("--trials", min=1, help="Episodes per method and intention (default 20; --preset table1: 5)")] = None,
-    budget: opt.Budget = D.budget,
-    seed: opt.Seed = D.seed,
-    test_scenes: opt.TestScenes = D.test_scenes,
-    test_pool: opt.TestPool = D.test_pool,
-    env: opt.Env = D.env,
-    user: opt.User = D.user,
-    new_scene: opt.NewScene = D.new_scene,
-    prior: opt.Prior = D.prior,
-    scenes: opt.Scenes = D.scenes,
-    llm: opt.Llm = D.llm,
-    vlm: opt.Vlm = None,
-    base_url: opt.BaseUrl = None,
-    cache: opt.Cache = None,
-    cache_mode: opt.CacheMode = D.cache_mode,
-    executor: opt.Executor = D.executor,
-    retriever: opt.Retriever = D.retriever,
-    variant: opt.Variant = D.variant,
-    epsilon: opt.Epsilon = D.epsilon,
-    early_threshold: opt.EarlyThreshold = D.early_threshold,
-    curve: Annotated[bool, typer.Option(help="Score after every signal (off: only at k = K; for slow models)")] = True,
+    seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the benchmark: each trial's seeds come from it")] = 0,
     jobs: Annotated[int, typer.Option("--jobs", min=1, help="Episodes run in parallel (processes; with --backend ray and no cluster: the CPUs of the local Ray)")] = 1,
     backend: Annotated[str, typer.Option("--backend", help="local (process pool) | ray (one task per episode; docs/scaling.md)")] = "local",
     ray_address: Annotated[str | None, typer.Option("--ray-address", help="With --backend ray: cluster to use (e.g. auto); default $RAY_ADDRESS, else a local Ray")] = None,
@@ -95,16 +92,18 @@ def bench(
     try:
         check_backend(backend)
         if preset is not None:
-            methods, suite, preset_trials = _apply_preset(preset, methods, intentions, budget)
+            methods, suite, preset_trials = _apply_preset(preset, methods, intentions, given.get("budget"))
+            given["budget"] = PRESETS[preset]["budget"]
             trials = trials or preset_trials
         trials = trials or 20
-        run = opt.run_spec(plugins=plugin, budget=budget, test_scenes=test_scenes, test_pool=test_pool, env=env, user=user,
-                           new_scene=new_scene, prior=prior, scenes=scenes, llm=llm, vlm=vlm, base_url=base_url, cache=cache,
-                           cache_mode=cache_mode, executor=executor, retriever=retriever, variant=variant,
-                           epsilon=epsilon, early_threshold=early_threshold, curve=curve, video="none")
+        run = opt.run_spec(**given, video="none")
         method_list = _split(methods) or ["bayes-preference", "bayes-stop", "zero-signal", "random-query"]
         for m in method_list:
-            check_spec(run.with_options(method=m))
+            check_spec(for_method(run, m))
+        unused = sorted(set(run.learner.settings) - {k for m in method_list for k in get_method(m).own(run.learner.settings)})
+        if unused:
+            raise ValueError(f"{', '.join('--' + u.replace('_', '-') for u in unused)}: none of the methods "
+                             f"({', '.join(method_list)}) has this setting")
         if suite is None:  # the paper suite only when nothing else says what to run
             suite = "" if intentions or intention_file else "paper"
         intention_list = _split(intentions) or [i for s in _split(suite) for i in suite_names(s)]
@@ -135,15 +134,18 @@ def bench(
     except ValueError as err:
         console.print(f"[red]error:[/red] {err}")
         raise typer.Exit(2) from None
-    settings = {**protocol_fields(run), "trials": trials, "seed": seed, **({"preset": preset} if preset else {})}
+    shared = {k: v for k, v in RunSpec(**run.model_dump(exclude={"learner"})).options().items()
+              if k not in (*BENCH_SETS, "plugin")}
+    shared.update(_settings_shown(run, method_list))
+    settings = {**shared, "trials": trials, "seed": seed, **({"preset": preset} if preset else {})}
     all_intentions = intention_list + list(intention_file or [])
     ceiling = None
     if oracle:
-        with speaking(run.learner.language):  # the ceiling of the language the learners spoke
+        with speaking(run.learner.settings.get("language", LATEST)):  # the ceiling of the language the learners spoke
             ceiling = oracle_of({i: resolve(None, i) if ".py:" in i else resolve(i) for i in all_intentions},
                                 progress=lambda text: print_line(console, text))
     report = write_report(records, method_list, all_intentions, out, settings, labels=labels, oracle=ceiling)
-    plot_success_vs_signals(records, method_list, budget, out, labels=labels, settings=settings)
+    plot_success_vs_signals(records, method_list, run.protocol.budget, out, labels=labels, settings=settings)
     console.print(report.read_text(), markup=False, soft_wrap=True)
     console.print(f"report: {out / 'report.md'}  plot: {out / 'success_vs_signals.png'}", markup=False)
 
@@ -228,8 +230,8 @@ def coverage(
     suite: Annotated[str, typer.Option("--suite", help="Comma-separated suites: paper, library, heldout, heldout2, dev, truth-goals")] = "",
     intentions: Annotated[str, typer.Option("--intentions", help="Comma-separated intentions (instead of --suite)")] = "",
     intention_file: Annotated[list[str] | None, typer.Option("--intention-file", help="Your own: path.py:NAME (repeatable)")] = None,
-    plugin: opt.Plugin = None,
-    seed: opt.Seed = D.seed,
+    plugin: Annotated[list[str] | None, typer.Option("--plugin", help="Python file registering intentions, suites… (repeatable)")] = None,
+    seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the scenes")] = 0,
     scenes: Annotated[int, typer.Option("--scenes", min=5, help="Scenes on which the best goal is chosen")] = 30,
     test_scenes: Annotated[int, typer.Option("--test-scenes", min=10, help="Further scenes on which its plan success is reported")] = 100,
     after_freeze: Annotated[bool, typer.Option("--after-freeze", help="Also print held-out intentions one by one (only after a freeze commit: docs/protocol.md)")] = False,

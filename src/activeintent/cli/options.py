@@ -1,62 +1,156 @@
-"""Command-line options shared by `run`, `bench` and `serve`: declared once here, defaults
-read from :class:`activeintent.spec.RunSpec` (``D``: its defaults under the options' names), so
-nothing is typed twice."""
+"""The options of a run's spec, made from the pydantic fields that declare them: the spec's
+sections (:func:`activeintent.spec.option_fields`) and every registered method's config class
+(``Method.settings``). `run`, `bench` and `serve` take them through :func:`spec_options`, so a
+setting is declared once, in its class, and a plug-in learner's new field is an option too."""
 
 from __future__ import annotations
 
+import inspect
+import os
+import types
+import typing
+from collections.abc import Callable
 from pathlib import Path
-from types import SimpleNamespace
-from typing import Annotated
+from typing import Annotated, Any, Literal
 
 import typer
+from pydantic.fields import FieldInfo
+from pydantic_core import PydanticUndefined
 
-from activeintent.spec import RunSpec
+from activeintent.learners.registry import get_method, method_names
+from activeintent.spec import RunSpec, option_fields
 from activeintent.web.basics import parse_video_size
-
-D = SimpleNamespace(**RunSpec().options())  # the defaults, by option name
-
-Method = Annotated[str, typer.Option("--method", help="Learner (see `activeintent methods`)")]
-Intention = Annotated[str | None, typer.Option("--intention", help="Hidden intention (see `activeintent intentions`)")]
-IntentionFile = Annotated[str | None, typer.Option("--intention-file", help="Your own intention: path.py:NAME")]
-Plugin = Annotated[list[str] | None, typer.Option("--plugin", help="Python file registering signals, methods, envs… (repeatable)")]
-Budget = Annotated[int, typer.Option("--budget", min=0, max=100, help="K: signals the user gives; every answer counts")]
-Seed = Annotated[int, typer.Option("--seed", min=0, help="Seed of every random choice")]
-TestSeed = Annotated[int | None, typer.Option("--test-seed", min=0, help="Seed of the test scenes (default: from --seed); a bench record's config.options.test_seed replays its episode")]
-TestScenes = Annotated[int, typer.Option("--test-scenes", min=1, max=200, help="Test scenes scored after every signal")]
-TestPool = Annotated[int, typer.Option("--test-pool", min=0, max=1000, help="More test scenes, scored after the last signal (k = K)")]
-Env = Annotated[str, typer.Option("--env", help="Where plans run: pybullet | symbolic")]
-User = Annotated[str, typer.Option("--user", help="Simulated-user preset: human | paper | exact (see docs/protocol.md)")]
-NewScene = Annotated[str, typer.Option("--new-scene", help="counted (every answer is a signal) | free (old rule, ≤3 uncounted) | off")]
-Prior = Annotated[str | None, typer.Option("--prior", help="Bayesian prior: length (description length) | uniform | fitted (lang-*: fitted to data/requests) | file:PATH (lang-*: written by `prior fit`); default: the method's own (lang-*: fitted, the others: length)")]
-Scenes = Annotated[str, typer.Option("--scenes", help="bayes-* and lang-*: scenes to ask in: sampled | belief (those the belief expects to show its goals) | a plug-in's (SCENE_DESIGNS)")]
-Llm = Annotated[str, typer.Option("--llm", help="LLM: embedded | gguf:/path.gguf | openai:<model> | none (Bayesian methods and baselines)")]
-Vlm = Annotated[str | None, typer.Option("--vlm", help="Multimodal model spec for the retriever (default: the LLM)")]
-BaseUrl = Annotated[str | None, typer.Option("--base-url", envvar="OPENAI_BASE_URL", help="OpenAI-compatible endpoint")]
-Cache = Annotated[str | None, typer.Option("--cache", help="Response cache file (SQLite); default ~/.cache/activeintent")]
-CacheMode = Annotated[str, typer.Option("--cache-mode", help="record | replay | off")]
-Executor = Annotated[str, typer.Option("--executor", help="y → plan: parse | plan | cap")]
-UnsafeNoIsolation = Annotated[bool, typer.Option("--unsafe-no-isolation", envvar="ACTIVEINTENT_UNSAFE_NO_ISOLATION", help="Run model-written code (--executor cap, proposed predicates) even without the bubblewrap sandbox (docs/security.md)")]
-Retriever = Annotated[str, typer.Option("--retriever", help="r from a stop: symbolic | vision")]
-Epsilon = Annotated[float, typer.Option("--epsilon", min=0.0, help="ε: seconds before the stop for image I_b")]
-EarlyThreshold = Annotated[float, typer.Option("--early-threshold", min=0.0, help="eq. 3: a stop earlier than this (s) shows no I_b")]
-Variant = Annotated[str, typer.Option("--variant", help="Paper methods: faithful (free text, reasoning, memory, T = 1) | structured")]
-Video = Annotated[str, typer.Option("--video", help="GIFs written: none | final | all")]
-Out = Annotated[Path | None, typer.Option("--out", help="Output folder")]
 
 
 def check_only() -> bool:
     """ACTIVEINTENT_CHECK_ONLY=1: commands validate their options and inputs, then stop before
     the work (the docs test runs every documented command this way)."""
-    import os
-
     return os.environ.get("ACTIVEINTENT_CHECK_ONLY") == "1"
 
 
-def run_spec(**values) -> RunSpec:
-    """The run's spec from CLI values (None: the default); a bad value becomes a message naming
-    the option."""
-    values = {k: v for k, v in values.items() if v is not None or k in ("intention", "intention_file", "vlm")}
-    values["plugins"] = list(values.get("plugins") or [])
+_PANELS = {"protocol": "Protocol", "models": "Models", "learner": "Learner", "act": "Learner", "env": "World",
+           "user": "World", None: "World"}
+
+
+def _cli_type(annotation: Any) -> Any:
+    """The type the command line parses a field as (pydantic judges the value afterwards)."""
+    origin = typing.get_origin(annotation)
+    if origin in (typing.Union, types.UnionType):
+        args = [a for a in typing.get_args(annotation) if a is not type(None)]
+        return _cli_type(args[0]) if len(args) == 1 else str
+    if origin is Literal:
+        return str
+    if origin is list:
+        return list[str]
+    return annotation if annotation in (bool, int, float, str) else str
+
+
+def _shown(value: Any) -> str:
+    return "none" if value is None else str(value).lower() if isinstance(value, bool) else str(value)
+
+
+def _help(info: FieldInfo, default: str | None) -> str:
+    text = (info.description or "").rstrip(".")
+    return f"{text} (default: {default})" if default else text
+
+
+def _families(names: list[str]) -> str:
+    """Method names, those sharing a first word as one ``word-*``."""
+    heads: dict[str, list[str]] = {}
+    for n in names:
+        heads.setdefault(n.split("-")[0], []).append(n)
+    return ", ".join(f"{h}-*" if len(v) > 1 else v[0] for h, v in heads.items())
+
+
+def setting_fields() -> dict[str, list[tuple[str, FieldInfo]]]:
+    """Every registered method's settings: field name → [(method, its FieldInfo)], in the order the
+    methods are listed."""
+    out: dict[str, list[tuple[str, FieldInfo]]] = {}
+    for name in method_names():
+        for field, info in get_method(name).settings.model_fields.items():
+            out.setdefault(field, []).append((name, info))
+    return out
+
+
+def _parameter(name: str, kind: Any, help_text: str, panel: str, info: FieldInfo) -> inspect.Parameter:
+    decl = f"--{name.replace('_', '-')}"
+    if kind is bool:
+        decl = f"{decl}/--no-{name.replace('_', '-')}"
+    extra = info.json_schema_extra if isinstance(info.json_schema_extra, dict) else {}
+    option = typer.Option(decl, help=help_text, rich_help_panel=panel, show_default=False,
+                          envvar=extra.get("envvar"))
+    return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=None,
+                             annotation=Annotated[kind | None, option])
+
+
+def spec_parameters(exclude: frozenset[str] = frozenset()) -> list[inspect.Parameter]:
+    """The spec's options as command parameters, each None unless given."""
+    params = []
+    for name, (section, _, info) in option_fields().items():
+        if name in exclude:
+            continue
+        default = None if info.default is PydanticUndefined else info.default
+        params.append(_parameter(name, _cli_type(info.annotation), _help(info, _shown(default) if default is not None
+                                 else None), _PANELS[section], info))
+    for name, owners in setting_fields().items():
+        if name in exclude:
+            continue
+        defaults: dict[str, list[str]] = {}
+        texts: dict[str, list[str]] = {}
+        for method, info in owners:
+            defaults.setdefault(_shown(info.default), []).append(method)
+            texts.setdefault((info.description or "").rstrip("."), []).append(method)
+        shown = (next(iter(defaults)) if len(defaults) == 1 else
+                 "; ".join(f"{_families(ms)}: {d}" for d, ms in defaults.items()))
+        described = (next(iter(texts)) if len(texts) == 1 else
+                     "; ".join(f"{_families(ms)}: {t}" for t, ms in texts.items()))
+        text = f"{described} (default: {shown}) [{_families([m for m, _ in owners])}]"
+        params.append(_parameter(name, _cli_type(owners[0][1].annotation), text.replace("[", "\\["),
+                                 "Learner settings", owners[0][1]))
+    return params
+
+
+class SpecCommand:
+    """A command whose options are its own parameters plus the spec's, the latter made when the
+    command line is built (after plug-ins registered their learners). The command receives the
+    spec's given values as ``given`` (option name → value; options not given are absent)."""
+
+    def __init__(self, func: Callable[..., Any], exclude: frozenset[str] = frozenset()):
+        self.func = func
+        self.exclude = exclude
+        self.__name__ = func.__name__
+        self.__qualname__ = func.__qualname__
+        self.__doc__ = func.__doc__
+        self.__module__ = func.__module__
+
+    def _own(self) -> list[inspect.Parameter]:
+        own = inspect.signature(self.func, eval_str=True).parameters.values()
+        return [p for p in own if p.name != "given"]
+
+    @property
+    def __signature__(self) -> inspect.Signature:  # read by typer when it builds the command
+        own = self._own()
+        names = {p.name for p in own}
+        spec = [p for p in spec_parameters(self.exclude) if p.name not in names]
+        return inspect.Signature([p.replace(kind=inspect.Parameter.KEYWORD_ONLY) for p in own] + spec)
+
+    @property
+    def __annotations__(self) -> dict[str, Any]:  # type: ignore[override]
+        return {p.name: p.annotation for p in self.__signature__.parameters.values()}
+
+    def __call__(self, **values: Any) -> Any:
+        own = {p.name for p in self._own()}
+        given = {k: v for k, v in values.items() if k not in own and v is not None}
+        return self.func(given=given, **{k: v for k, v in values.items() if k in own})
+
+
+def spec_command(exclude: tuple[str, ...] = ()) -> Callable[[Callable[..., Any]], SpecCommand]:
+    """Decorator: the command takes the spec's options (but ``exclude``), see :class:`SpecCommand`."""
+    return lambda func: SpecCommand(func, frozenset(exclude))
+
+
+def run_spec(**values: Any) -> RunSpec:
+    """The run's spec from option values; a bad value becomes a message naming the option."""
     return RunSpec.from_options(**values)
 
 
@@ -71,3 +165,5 @@ VideoSize = Annotated[str, typer.Option(
     "--video-size", callback=_video_size,
     help="Videos' WIDTHxHEIGHT in pixels (64-2048 each), or one number for a square; at the default every "
     "block is at least 40 px wide, larger takes longer to render before each round")]
+Out = Annotated[Path | None, typer.Option("--out", help="Output folder")]
+UnsafeNoIsolation = Annotated[bool, typer.Option("--unsafe-no-isolation", envvar="ACTIVEINTENT_UNSAFE_NO_ISOLATION", help="Run model-written code (--executor cap, proposed predicates) even without the bubblewrap sandbox (docs/security.md)")]

@@ -8,7 +8,6 @@ import typer
 
 from activeintent.act.isolation import allow_unsafe_no_isolation
 from activeintent.cli import options as opt
-from activeintent.cli.options import D
 from activeintent.learners.registry import get_method
 from activeintent.llm.base import ModelError
 from activeintent.progress_lines import Eta, print_line
@@ -126,34 +125,10 @@ class LiveTable:
         self._write(None)
 
 
+@opt.spec_command()
 def run(
-    method: opt.Method = D.method,
-    intention: opt.Intention = None,
-    intention_file: opt.IntentionFile = None,
-    plugin: opt.Plugin = None,
-    budget: opt.Budget = D.budget,
-    seed: opt.Seed = D.seed,
-    test_seed: opt.TestSeed = None,
-    test_scenes: opt.TestScenes = D.test_scenes,
-    test_pool: opt.TestPool = D.test_pool,
-    env: opt.Env = D.env,
-    user: opt.User = D.user,
-    new_scene: opt.NewScene = D.new_scene,
-    prior: opt.Prior = D.prior,
-    scenes: opt.Scenes = D.scenes,
-    llm: opt.Llm = D.llm,
-    vlm: opt.Vlm = None,
-    base_url: opt.BaseUrl = None,
-    cache: opt.Cache = None,
-    cache_mode: opt.CacheMode = D.cache_mode,
-    executor: opt.Executor = D.executor,
+    given: dict,
     unsafe_no_isolation: opt.UnsafeNoIsolation = False,
-    retriever: opt.Retriever = D.retriever,
-    epsilon: opt.Epsilon = D.epsilon,
-    early_threshold: opt.EarlyThreshold = D.early_threshold,
-    variant: opt.Variant = D.variant,
-    video: opt.Video = D.video,
-    design_scenes: bool = typer.Option(D.design_scenes, help="Let the learner choose each round's objects"),
     out: opt.Out = None,
 ) -> None:
     """Run one episode: the learner asks, a simulated user with a hidden intention answers."""
@@ -167,26 +142,22 @@ def run(
     if unsafe_no_isolation:
         allow_unsafe_no_isolation()
     try:
-        spec = opt.run_spec(
-            method=method, intention=intention, intention_file=intention_file, plugins=plugin, budget=budget,
-            seed=seed, test_seed=test_seed, test_scenes=test_scenes, test_pool=test_pool, env=env, user=user, new_scene=new_scene, prior=prior, scenes=scenes, llm=llm,
-            vlm=vlm, base_url=base_url, cache=cache, cache_mode=cache_mode, executor=executor,
-            retriever=retriever, epsilon=epsilon, early_threshold=early_threshold, variant=variant, video=video,
-            design_scenes=design_scenes,
-            )
+        spec = opt.run_spec(**given)
     except ValueError as err:
         console.print(f"[red]error:[/red] {escape(str(err))}", soft_wrap=True)
         raise typer.Exit(2) from None
+    p, method, who = spec.protocol, spec.learner.method, spec.user
+    intention, intention_file, llm = who.intention, who.intention_file, spec.models.llm
     note = None
-    if (test_scenes, test_pool) == (D.test_scenes, D.test_pool) and method_asks_a_model(method):
+    if not {"test_scenes", "test_pool"} & set(given) and method_asks_a_model(method):
         # Every test scene is a model call (and a planner call) for these learners: a curve of
         # 10 scenes at k = 0…K and a pool of 70 at K took most of an hour on 2 cores.
         spec = spec.with_options(curve=False, test_pool=0)
-        note = (f"{method} asks the model for every test scene: scored at k = {budget} only, on the "
-                f"{test_scenes} curve scenes (--test-pool N adds the pool and the curve; bench scores the whole protocol)")
+        note = (f"{method} asks the model for every test scene: scored at k = {p.budget} only, on the "
+                f"{p.test_scenes} curve scenes (--test-pool N adds the pool and the curve; bench scores the whole protocol)")
     name = intention or (Path(intention_file.split(":")[0]).stem if intention_file else DEFAULT_INTENTION)
-    out_dir = out or Path("runs") / f"{method}-{name}-seed{seed}"
-    live = LiveTable(console, method, budget, seed, llm=llm, lines=not console.is_terminal)
+    out_dir = out or Path("runs") / f"{method}-{name}-seed{p.seed}"
+    live = LiveTable(console, method, p.budget, p.seed, llm=llm, lines=not console.is_terminal)
     if opt.check_only():
         try:
             check_spec(spec)

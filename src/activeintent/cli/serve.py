@@ -10,9 +10,9 @@ from typing import Annotated
 import typer
 
 from activeintent.cli import options as opt
-from activeintent.cli.options import D
 from activeintent.intentions.registry import IntentionError
 from activeintent.learners.registry import get_method
+from activeintent.protocol import DEFAULT_BUDGET
 from activeintent.runner import check_spec
 from activeintent.suites import resolve as resolve_intention
 from activeintent.web.basics import VIDEO_SIZE_TEXT
@@ -26,18 +26,21 @@ class ShowEstimate(StrEnum):
     always = "always"
 
 
+# What each session gets from the server, not from options.
+SESSION_SETS = ("test_seed", "video", "video_fps", "curve", "stop_when_done")
+
+
 def register(app: typer.Typer) -> None:
     app.command(name="serve")(serve)
     app.command(name="study-export")(study_export)
 
 
+@opt.spec_command(exclude=SESSION_SETS)
 def serve(
+    given: dict,
     host: Annotated[str, typer.Option("--host", help="Address to bind (loopback unless told otherwise)")] = "127.0.0.1",
     port: Annotated[int, typer.Option("--port", min=0, max=65535, help="TCP port")] = 8000,
     method: Annotated[str | None, typer.Option("--method", help="preference | mllm | mllm-llm | bayes-preference | bayes-stop | lang-preference | lang-stop (default bayes-preference; with --study: the study file's conditions)")] = None,
-    prior: opt.Prior = D.prior,
-    scenes: opt.Scenes = D.scenes,
-    rounds: opt.Budget = D.budget,
     intention: Annotated[str | None, typer.Option("--intention", help="Assign this rule to every participant (shown on the start page; success is scored against it). Without it each participant picks their own rule and success is not scored (free-rule design)")] = None,
     intention_file: Annotated[str | None, typer.Option("--intention-file", help="Assign your own rule: path.py:NAME (as --intention)")] = None,
     seed: Annotated[int, typer.Option("--seed", help="Session n runs with seed + n")] = 0,
@@ -46,13 +49,6 @@ def serve(
     study: Annotated[Path | None, typer.Option("--study", help="A study file (.json or .toml): consent text, completion code and redirect, and the conditions (method × rule × guess display) participants are assigned to in a balanced way; replaces --method, --intention and --show-estimate")] = None,
     video_size: opt.VideoSize = VIDEO_SIZE_TEXT,
     llm: Annotated[str | None, typer.Option("--llm", help="LLM: embedded | gguf:/path.gguf | openai:<model> | none (default: embedded for methods that need a model, none for the others)")] = None,
-    vlm: opt.Vlm = None,
-    base_url: opt.BaseUrl = None,
-    cache: opt.Cache = None,
-    cache_mode: opt.CacheMode = D.cache_mode,
-    executor: opt.Executor = D.executor,
-    retriever: opt.Retriever = D.retriever,
-    plugin: opt.Plugin = None,
     answer_timeout: Annotated[float, typer.Option("--answer-timeout", min=1.0, help="Seconds to wait for one answer before a session is abandoned")] = 1800.0,
     max_sessions: Annotated[int, typer.Option("--max-sessions", min=1, help="Sessions in progress at once")] = 4,
     max_sessions_per_client: Annotated[int, typer.Option("--max-sessions-per-client", min=1, help="Sessions in progress at once from one client address")] = 2,
@@ -80,8 +76,8 @@ def serve(
     from activeintent.web.session import StudyConfig
 
     size = tuple(video_size)  # parsed by the option
-    extra = dict(prior=prior, scenes=scenes, vlm=vlm, base_url=base_url, cache=cache,
-                 cache_mode=cache_mode, executor=executor, retriever=retriever, plugins=list(plugin or []))
+    extra = {k: v for k, v in given.items() if k != "budget"}
+    rounds = given.get("budget", DEFAULT_BUDGET)
     study_file = None
     if study is not None:
         given = [name for name, v in (("--method", method), ("--intention", intention),

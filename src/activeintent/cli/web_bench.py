@@ -12,7 +12,6 @@ import numpy as np
 import typer
 
 from activeintent.cli import options as opt
-from activeintent.cli.options import D
 from activeintent.web.basics import VIDEO_SIZE_TEXT
 from activeintent.web.wait_bench import measure_waits
 
@@ -27,7 +26,7 @@ def web_bench(
     video_size: opt.VideoSize = VIDEO_SIZE_TEXT,
     sessions: Annotated[int, typer.Option("--sessions", min=1, max=20, help="Sessions, one after another (seeds 0, 1, …)")] = 2,
     intention: Annotated[str | None, typer.Option("--intention", help="An assigned rule (default: free rule)")] = None,
-    seed: opt.Seed = D.seed,
+    seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the sessions")] = 0,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON only")] = False,
 ) -> None:
     """Measure the wait between rounds of the web study (p50 / p90; target p90 ≤ 3 s at 480 px)."""

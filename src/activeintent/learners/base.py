@@ -4,13 +4,13 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
+from typing import Any
 
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from activeintent.llm.base import ChatModel
 from activeintent.signals import Answer
-from activeintent.spec import LearnerConfig
 from activeintent.world import Scene, Skill, WorldState
 from activeintent.world.trajectory import Trajectory
 
@@ -56,6 +56,9 @@ class Learner(ABC):
     retriever: str | None = None  # which retriever produced r (stop methods), for the logs
     # Does it design the scene that follows a "new scene" answer? (else the episode samples one)
     redesigns_after_new_scene: bool = False
+    # Should the executor try its parser on y before its model? (the structured paper methods' y
+    # are written for it)
+    executor_parses_first: bool = False
 
     def execution_failed(self, goal: str, reason: str) -> None:  # noqa: B027 - optional hook
         """The executor could not turn goal y into motion; the next estimate should be simpler."""
@@ -95,37 +98,65 @@ class Learner(ABC):
         """The current z and one y for a test scene (called after every signal)."""
 
 
+class NoSettings(BaseModel):
+    """The settings of a method that has none."""
+
+    model_config = ConfigDict(extra="forbid")
+
+
 @dataclass
 class LearnerContext:
     """Everything a method may need to build its learner: the models, the learner's own random
-    stream (EpisodeSeeds.learner, not the episode's seed) and the spec's learner section."""
+    stream (EpisodeSeeds.learner, not the episode's seed) and its settings (an instance of its
+    config class, ``Method.settings``)."""
 
     llm: ChatModel | None = None
     vlm: ChatModel | None = None
     learner_seed: int = 0
-    config: LearnerConfig = field(default_factory=LearnerConfig)
+    settings: BaseModel = field(default_factory=NoSettings)
 
 
 @dataclass
 class Method:
+    """A learner by name: what it reads, how it is built and the settings it takes.
+
+    ``settings`` is its config class (pydantic): its fields are the method's settings, each
+    declared there once; the command line offers them as options, the spec holds them
+    (``learner.settings``) and the records keep them as the episode ran."""
+
     signal: str
     needs_llm: bool
     build: Callable[[LearnerContext], Learner]
     help: str = ""
     family: str = "ours"  # paper | ours | baseline
-    goal_language: bool = False  # its hypotheses are goals of the language: --prior fitted / file: apply
+    goal_language: bool = False  # its hypotheses are goals of the language
     colour: str | None = None  # its colour in every report figure (None: a spare colour by a hash of its name)
     compared_with: str | None = None  # reports pair it with this method on the same trials (e.g. its random-question twin)
+    settings: type[BaseModel] = NoSettings
 
-    @property
-    def default_prior(self) -> str:
-        """Its prior when ``--prior`` is not given: the goal language's learners take the prior
-        fitted to what people ask (chosen on dev: experiments/defaults), the others length."""
-        return "fitted" if self.goal_language else "length"
+    def own(self, given: dict[str, Any]) -> dict[str, Any]:
+        """The given settings that are this method's (a benchmark gives one set to every method)."""
+        return {k: v for k, v in given.items() if k in self.settings.model_fields}
+
+    def configure(self, name: str, given: dict[str, Any]) -> BaseModel:
+        """Its settings from the given values (the rest: the config class's defaults); ValueError
+        naming the option when a value is bad or the method has no such setting."""
+        unknown = sorted(set(given) - set(self.settings.model_fields))
+        if unknown:
+            valid = ", ".join(f"--{f.replace('_', '-')}" for f in self.settings.model_fields) or "none"
+            raise ValueError(f"{', '.join('--' + u.replace('_', '-') for u in unknown)}: {name} has no such setting "
+                             f"(its settings: {valid})")
+        try:
+            return self.settings.model_validate(given)
+        except ValidationError as err:
+            raise ValueError("; ".join(
+                f"--{'.'.join(map(str, e['loc'])).replace('_', '-')}: {e['msg']} (got {e.get('input')!r})" if e["loc"]
+                else e["msg"].removeprefix("Value error, ") for e in err.errors())) from None
 
     def __call__(self, ctx: LearnerContext) -> Learner:
         if self.needs_llm and ctx.llm is None:
             raise ValueError("this method needs a language model (--llm embedded, gguf:…, openai:…)")
-        if ctx.config.prior is None:  # the spec leaves it to the method
-            ctx = replace(ctx, config=ctx.config.model_copy(update={"prior": self.default_prior}))
+        if not isinstance(ctx.settings, self.settings):
+            ctx = LearnerContext(ctx.llm, ctx.vlm, ctx.learner_seed,
+                                 self.settings.model_validate(ctx.settings.model_dump(exclude_unset=True)))
         return self.build(ctx)

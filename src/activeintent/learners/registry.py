@@ -12,6 +12,7 @@ from activeintent.learners.base import Learner, LearnerContext, Method
 from activeintent.learners.bayes.learner import (
     BayesConfig,
     BayesLearner,
+    BayesSettings,
     RandomQueryLearner,
     ZeroSignalLearner,
 )
@@ -26,56 +27,60 @@ METHODS: Registry[Method] = Registry("method")
 
 
 def _bayes(signal: str, kind: str = "eig") -> Callable[[LearnerContext], Learner]:
+    cls = {"eig": BayesLearner, "random": RandomQueryLearner, "zero": ZeroSignalLearner}[kind]
+
     def build(ctx: LearnerContext) -> Learner:
-        cls = {"eig": BayesLearner, "random": RandomQueryLearner, "zero": ZeroSignalLearner}[kind]
-        config = BayesConfig(prior=ctx.config.prior, scenes=ctx.config.scenes)  # type: ignore[arg-type]
-        return cls(signal, rng=ctx.learner_seed, llm=ctx.llm, config=config)
+        return cls(signal, rng=ctx.learner_seed, llm=ctx.llm, config=BayesConfig(**ctx.settings.model_dump()))
 
     return build
 
 
 def _paper(kind: str) -> Callable[[LearnerContext], Learner]:
     def build(ctx: LearnerContext) -> Learner:
-        # variant and retriever were validated with the spec (spec.LearnerConfig)
-        if ctx.config.variant == "faithful":
-            cfg = f.FaithfulConfig(design_scenes=ctx.config.design_scenes, epsilon=ctx.config.epsilon,
-                                   early_threshold=ctx.config.early_threshold, seed=ctx.learner_seed)
+        s = ctx.settings
+        assert isinstance(s, p.PaperSettings)
+        if s.variant == "faithful":
+            cfg = f.FaithfulConfig(**s.model_dump(), seed=ctx.learner_seed)
             if kind == "preference":
                 return f.FaithfulPreferenceLearner(ctx.llm, cfg)  # type: ignore[arg-type]
             if kind == "mllm":
                 return f.FaithfulMllmLearner(ctx.vlm or ctx.llm, cfg)  # type: ignore[arg-type]
-            return f.FaithfulMllmLlmLearner(ctx.llm, ctx.vlm, retriever=ctx.config.retriever, config=cfg)  # type: ignore[arg-type]
+            return f.FaithfulMllmLlmLearner(ctx.llm, ctx.vlm, retriever=s.retriever, config=cfg)  # type: ignore[arg-type]
 
-        config = p.PaperLearnerConfig(design_scenes=ctx.config.design_scenes, epsilon=ctx.config.epsilon,
-                                      early_threshold=ctx.config.early_threshold)
+        config = p.PaperLearnerConfig(**s.model_dump())
         if kind == "preference":
             return p.PreferenceLearner(ctx.llm, config)  # type: ignore[arg-type]
         if kind == "mllm":
             return p.MllmLearner(ctx.vlm or ctx.llm, config)  # type: ignore[arg-type]
-        return p.MllmLlmLearner(ctx.llm, ctx.vlm, retriever=ctx.config.retriever, config=config)  # type: ignore[arg-type]
+        return p.MllmLlmLearner(ctx.llm, ctx.vlm, retriever=s.retriever, config=config)  # type: ignore[arg-type]
 
     return build
 
 
 METHODS.register("preference", lambda: Method("preference", True, _paper("preference"),
-                 "the paper's eq. 1–2: the LLM estimates z, then two goals y^a, y^b", "paper", colour="#9467bd"))
+                 "the paper's eq. 1–2: the LLM estimates z, then two goals y^a, y^b", "paper", colour="#9467bd",
+                 settings=p.PaperSettings))
 METHODS.register("mllm", lambda: Method("stop", True, _paper("mllm"),
-                 "the paper: one multimodal model reads prompt(h) (eq. 3) and gives z, y", "paper", colour="#8c564b"))
+                 "the paper: one multimodal model reads prompt(h) (eq. 3) and gives z, y", "paper", colour="#8c564b",
+                 settings=p.PaperSettings))
 METHODS.register("mllm-llm", lambda: Method("stop", True, _paper("mllm-llm"),
-                 "the paper's best: a retriever gives r (eq. 4), the LLM gives z, y (eq. 5–6)", "paper", colour="#e377c2"))
+                 "the paper's best: a retriever gives r (eq. 4), the LLM gives z, y (eq. 5–6)", "paper", colour="#e377c2",
+                 settings=p.PaperSettings))
 METHODS.register("bayes-preference", lambda: Method("preference", False, _bayes("preference"),
                  "ours: belief over z, A/B queries by expected information gain", colour="#ff7f0e",
-                 compared_with="random-query-preference"))
+                 compared_with="random-query-preference", settings=BayesSettings))
 METHODS.register("bayes-stop", lambda: Method("stop", False, _bayes("stop"),
                  "ours: belief over z, stop queries by expected information gain", colour="#1f77b4",
-                 compared_with="random-query"))
+                 compared_with="random-query", settings=BayesSettings))
 METHODS.register("zero-signal", lambda: Method("stop", False, _bayes("stop", "zero"),
-                 "baseline: the prior's best guess, asks nothing", "baseline", colour="#7f7f7f"))
+                 "baseline: the prior's best guess, asks nothing", "baseline", colour="#7f7f7f",
+                 settings=BayesSettings))
 METHODS.register("random-query", lambda: Method("stop", False, _bayes("stop", "random"),
-                 "baseline: bayes-stop's belief update with random stop queries", "baseline", colour="#aec7e8"))
+                 "baseline: bayes-stop's belief update with random stop queries", "baseline", colour="#aec7e8",
+                 settings=BayesSettings))
 METHODS.register("random-query-preference", lambda: Method("preference", False, _bayes("preference", "random"),
                  "baseline: bayes-preference's belief update with random A/B queries", "baseline",
-                 colour="#ffbb78"))
+                 colour="#ffbb78", settings=BayesSettings))
 METHODS.register("lang-stop", lambda: lang_method("stop"))
 METHODS.register("lang-preference", lambda: lang_method("preference"))
 METHODS.register("lang-zero-signal", lang_zero_signal)
@@ -111,7 +116,7 @@ def get_method(name: str) -> Method:
     signal = _derived().get(name)
     if signal is None:  # the error lists the derived names too
         raise UnknownName(f"Unknown method {name!r}; valid methods: {', '.join(method_names())}.")
-    return Method(signal, False, _bayes(signal), f"ours, for the {signal} signal")
+    return Method(signal, False, _bayes(signal), f"ours, for the {signal} signal", settings=BayesSettings)
 
 
 def check_method(name: str) -> str:

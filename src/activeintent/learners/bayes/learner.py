@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from pydantic import BaseModel, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from activeintent import ranking
 from activeintent.goals.facts import facts
@@ -51,16 +51,28 @@ def kl_bits(after: np.ndarray, before: np.ndarray) -> float:
     return float((after[m] * np.log2(after[m] / np.clip(before[m], 1e-300, None))).sum())
 
 
-class BayesConfig(BaseModel):
+class BayesSettings(BaseModel):
+    """What a person running the Bayesian learners chooses (the rest of BayesConfig is fixed)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    prior: Prior = Field("length", description="P(z): length (description length, 2^-L(z)) | uniform (the ablation)")
+    scenes: str = Field(
+        "sampled", description="Scenes to ask in (SCENE_DESIGNS): sampled (n_scenes random ones) | belief (the "
+        "n_scenes of scene_candidates random ones that the belief most expects to show its goals, also after a "
+        "'new scene' answer) | a plug-in's")
+
+    @field_validator("scenes")
+    @classmethod
+    def _known_design(cls, name: str) -> str:
+        return SCENE_DESIGNS.check(name)
+
+
+class BayesConfig(BayesSettings):
     """Settings of the Bayesian learners (none is tuned to particular intentions)."""
 
-    prior: Prior = Field("length", description="length: P(z) ∝ 2^-L(z); uniform: the ablation")
     choose: str = Field("eig", description="eig: largest expected information gain; random: the baseline")
     n_scenes: int = Field(4, ge=1, description="candidate scenes scored per design_scene")
-    scenes: str = Field(
-        "sampled", description="how the candidate scenes are chosen (scenes.py, SCENE_DESIGNS): sampled: n_scenes random "
-        "scenes; belief: the n_scenes of scene_candidates random ones that the belief most expects to show "
-        "its goals, also after a 'new scene' answer")
     scene_candidates: int = Field(16, ge=1, description="scenes drawn per design_scene when scenes = belief")
     top_k: int = Field(16, ge=1, description="plans come from this many most probable hypotheses")
     explore: int = Field(6, ge=0, description="... plus this many random other hypotheses")
@@ -72,11 +84,6 @@ class BayesConfig(BaseModel):
     proposal_mass: float = Field(0.05, gt=0, lt=1, description="prior mass given to model-proposed hypotheses")
     max_proposal_calls: int = Field(3, ge=0, description="model calls for new hypotheses per episode")
     hypothesis_seed: int = Field(0, description="seed of the bank that deduplicates H")
-
-    @field_validator("scenes")
-    @classmethod
-    def _known_design(cls, name: str) -> str:
-        return SCENE_DESIGNS.check(name)
 
 
 @dataclass

@@ -10,14 +10,14 @@ their prior 2^-L(z) and their likelihood on every answer so far.
 from __future__ import annotations
 
 import numpy as np
-from pydantic import Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import LATEST, Goal, speaking
-from activeintent.goals.prior import goal_bits
+from activeintent.goals.language import LATEST, Goal, check_language, speaking
+from activeintent.goals.prior import goal_bits, load_prior
 from activeintent.learners.base import LearnerContext, Method, RoundRecord
 from activeintent.learners.bayes.judge import HypothesisJudge, trajectory_steps, utility
-from activeintent.learners.bayes.learner import BayesConfig, BayesLearner
+from activeintent.learners.bayes.learner import BayesConfig, BayesLearner, BayesSettings
 from activeintent.learners.lang.hypotheses import LangHypothesis, LangSpace, lang_space
 from activeintent.learners.lang.proposals import neighbours, propose_goals
 from activeintent.llm.base import ModelError
@@ -79,13 +79,34 @@ class LangJudge(HypothesisJudge):
         return out
 
 
-class LangConfig(BayesConfig):
-    """The Bayesian learner's settings plus how the space grows (none tuned to intentions)."""
+class LangPriorSettings(BaseModel):
+    """What a person chooses for any learner over the goal language: its prior and version."""
 
-    prior: str = Field("length", pattern="^(length|uniform|fitted|file:.+)$",  # type: ignore[assignment]
-                       description="length: P(z) ∝ 2^-L(z); fitted: fitted to data/requests (goals/prior.py); "
-                       "file:PATH: written by `prior fit`; uniform: the ablation")
-    language: int = Field(LATEST, description="the goal language's version (goals/language.py LANGUAGES)")
+    model_config = ConfigDict(extra="forbid")
+
+    prior: str = Field("fitted", pattern="^(length|uniform|fitted|file:.+)$",
+                       description="P(z): fitted (to what people ask, data/requests; goals/prior.py) | length "
+                       "(description length) | file:PATH (written by `prior fit`) | uniform (the ablation)")
+    language: int = Field(LATEST, description="The goal language's version (recorded, so that an episode run before "
+                          "the language grew replays in its own)")
+
+    @field_validator("language")
+    @classmethod
+    def _known_language(cls, version: int) -> int:
+        return check_language(version)
+
+    @model_validator(mode="after")
+    def _prior_loads(self) -> LangPriorSettings:
+        load_prior(self.prior, self.language)  # a missing, malformed or other-language file is refused before any work
+        return self
+
+
+class LangSettings(LangPriorSettings, BayesSettings):
+    """... and, for those that ask, how their scenes are chosen."""
+
+
+class LangConfig(LangSettings, BayesConfig):
+    """The Bayesian learner's settings plus how the space grows (none tuned to intentions)."""
 
     rejuvenate_top: int = Field(8, ge=0, description="after each answer, neighbours of this many likely goals join")
     join_partners: int = Field(32, ge=0, description="... and each of them joined with each of this many likely goals")
@@ -206,15 +227,14 @@ class LangLearner(BayesLearner):
 
 
 def lang_method(signal: str) -> Method:
-    """The registry entry of ``lang-<signal>`` (built from a LearnerContext like ``bayes``)."""
+    """The registry entry of ``lang-<signal>``."""
 
     def build(ctx: LearnerContext) -> LangLearner:
-        return LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm,
-                           config=LangConfig(prior=ctx.config.prior, scenes=ctx.config.scenes,  # type: ignore[arg-type]
-                                             language=ctx.config.language))
+        return LangLearner(signal, rng=ctx.learner_seed, llm=ctx.llm, config=LangConfig(**ctx.settings.model_dump()))
 
     return Method(signal, False, build, f"ours: growing belief over the goal language, {signal} queries by EIG",
-                  goal_language=True, colour={"stop": "#2ca02c", "preference": "#98df8a"}.get(signal))
+                  goal_language=True, colour={"stop": "#2ca02c", "preference": "#98df8a"}.get(signal),
+                  settings=LangSettings)
 
 
 def lang_zero_signal() -> Method:
@@ -222,10 +242,10 @@ def lang_zero_signal() -> Method:
     lang-* under the same prior)."""
 
     def build(ctx: LearnerContext) -> LangLearner:
-        learner = LangLearner("stop", rng=ctx.learner_seed, config=LangConfig(prior=ctx.config.prior, language=ctx.config.language))  # type: ignore[arg-type]
+        learner = LangLearner("stop", rng=ctx.learner_seed, config=LangConfig(**ctx.settings.model_dump()))
         learner.asks = False
         learner.name = "lang-zero-signal"
         return learner
 
     return Method("stop", False, build, "baseline: the goal language's prior best guess, asks nothing",
-                  "baseline", goal_language=True)
+                  "baseline", goal_language=True, settings=LangPriorSettings)

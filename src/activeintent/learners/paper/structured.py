@@ -14,7 +14,7 @@ import re
 import time
 from typing import Literal
 
-from pydantic import BaseModel, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from activeintent.learners import prompts
 from activeintent.learners.base import Estimate, Learner, RoundRecord
@@ -49,10 +49,31 @@ def failure_reason(text: str | None) -> str:
     return text or "no reason given"
 
 
-class PaperLearnerConfig(BaseModel):
-    design_scenes: bool = True  # the learner chooses the objects of each round's scene
-    epsilon: float = 2.0  # ε: seconds before the stop for the image I_b (eq. 3)
-    early_threshold: float | None = None  # eq. 3's "h < ε": a stop before this shows no I_b (None: ε)
+VARIANTS = ("faithful", "structured")
+
+
+class PaperSettings(BaseModel):
+    """What a person running the paper's methods chooses."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    variant: str = Field("faithful", description="faithful (as the paper ran them: free text, reasoning, memory, "
+                         "T = 1) | structured")
+    retriever: str = Field("symbolic", pattern="^(symbolic|vision)$", description="r from a stop: symbolic | vision")
+    design_scenes: bool = Field(True, description="Let the learner choose each round's objects")
+    epsilon: float = Field(2.0, ge=0, description="ε: seconds before the stop for image I_b (eq. 3)")
+    early_threshold: float | None = Field(2.0, ge=0, description="eq. 3's \"h < ε\": a stop earlier than this (s) "
+                                          "shows no I_b (None: ε)")
+
+    @field_validator("variant")
+    @classmethod
+    def _known_variant(cls, v: str) -> str:
+        if v not in VARIANTS:
+            raise ValueError(f"Unknown variant {v!r}; valid variants: {', '.join(VARIANTS)}.")
+        return v
+
+
+class PaperLearnerConfig(PaperSettings):
     image_size: int = 240
     max_tokens: int = 256
 
@@ -61,6 +82,7 @@ class _ModelLearner(Learner):
     """Shared plumbing: model calls with a transcript, history text, scene design."""
 
     variant = "structured"
+    executor_parses_first = True
 
     def __init__(self, llm: ChatModel, config: PaperLearnerConfig | None = None):
         self.llm = llm
