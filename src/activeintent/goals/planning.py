@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from functools import lru_cache
 
 import numpy as np
@@ -69,9 +69,15 @@ def put_free(
     return None
 
 
-def nearest_points(state: WorldState, block: str) -> list[tuple[float, float]]:
+def nearest_points(state: WorldState, block: str, points: Iterable[tuple[float, float]] = GRID) -> list[tuple[float, float]]:
+    """``points`` (default: the grid), nearest ``block`` first."""
     here = state.pos(block)[:2]
-    return sorted(GRID, key=lambda p: (p[0] - here[0]) ** 2 + (p[1] - here[1]) ** 2)
+    return sorted(points, key=lambda p: (p[0] - here[0]) ** 2 + (p[1] - here[1]) ** 2)
+
+
+def free_points(state: WorldState, pts: Iterable[tuple[float, float]], b: str, n: int = 6) -> list[Skill]:
+    """PutAt skills to the first ``n`` points of ``pts`` (the planner checks they are free)."""
+    return [PutAt(block=b, position=p) for p in list(pts)[:n]]
 
 
 def run(state: WorldState, steps: list[Skill]) -> WorldState | None:

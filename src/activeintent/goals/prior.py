@@ -31,17 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-from activeintent.goals.language import (
-    MAX_CLAUSES,
-    QUANTS,
-    Each,
-    Form,
-    Goal,
-    check_language,
-    nodes,
-    parse_goal,
-    spoken,
-)
+from activeintent.goals.goal import MAX_CLAUSES, QUANTS, Each, Form, Goal, parse_goal
+from activeintent.goals.nodes import check_language, nodes, spoken
 
 ALPHAS = (0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0)  # the smoothing strengths tried
 # The priors fitted to data/requests, shipped as package data: one per language version.

@@ -58,17 +58,8 @@ from pathlib import Path
 import numpy as np
 
 from activeintent.goals.facts import facts
-from activeintent.goals.language import (
-    MAX_CLAUSES,
-    QUANTS,
-    Each,
-    Form,
-    Goal,
-    all_clauses,
-    nodes,
-    parse_goal,
-    speaking,
-)
+from activeintent.goals.goal import MAX_CLAUSES, QUANTS, Each, Form, Goal, all_clauses, parse_goal
+from activeintent.goals.nodes import nodes, speaking
 from activeintent.learners.lang.hypotheses import GoalIntention
 from activeintent.protocol import (
     DEFAULT_TEST_POOL,

@@ -67,6 +67,11 @@ def color_of(name: str) -> str:
     return name.split(" ", 1)[0]
 
 
+def own_bowl(block: str) -> str:
+    """The bowl of ``block``'s colour."""
+    return f"{color_of(block)} bowl"
+
+
 def footprint_radius(name: str) -> float:
     return BOWL_RADIUS if kind_of(name) == "bowl" else BLOCK_SIZE / 2
 

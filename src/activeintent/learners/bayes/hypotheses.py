@@ -27,24 +27,6 @@ from pathlib import Path
 import numpy as np
 
 from activeintent.goals.facts import Facts, facts, is_cool, is_warm
-from activeintent.goals.language import (
-    Cluster,
-    Column,
-    Corners,
-    Flat,
-    InBowl,
-    InCell,
-    InNamedBowl,
-    InRegion,
-    NextTo,
-    OneBowl,
-    OnTable,
-    Row,
-    SeparateBowls,
-    Tower,
-    TowerOnBlock,
-    TwoTowersAnyHeights,
-)
 from activeintent.goals.planning import run
 from activeintent.goals.recipes import (
     EveryBlock,
@@ -58,6 +40,26 @@ from activeintent.goals.recipes import (
     OnePerBowl,
     Stack,
     TwoStacks,
+)
+from activeintent.goals.relations import (
+    Flat,
+    InBowl,
+    InCell,
+    InNamedBowl,
+    InRegion,
+    NextTo,
+    OnTable,
+)
+from activeintent.goals.structures import (
+    Cluster,
+    Column,
+    Corners,
+    OneBowl,
+    Row,
+    SeparateBowls,
+    Tower,
+    TowerOnBlock,
+    TwoTowersAnyHeights,
 )
 from activeintent.intentions.base import Intention
 from activeintent.memo import BoundedCache
@@ -381,7 +383,8 @@ def _cache_sources() -> list[Path]:
     recipes its leaves are (and the facts, placing helpers and node registry they are built on),
     all of world/, intentions/."""
     pkg = Path(__file__).resolve().parents[2]
-    goals = [pkg / "goals" / name for name in ("__init__.py", "facts.py", "language.py", "planning.py", "recipes.py",
+    goals = [pkg / "goals" / name for name in ("__init__.py", "facts.py", "nodes.py", "selectors.py", "relations.py",
+                                                "structures.py", "goal.py", "language.py", "planning.py", "recipes.py",
                                                 "requested.py")]
     return [pkg / "learners" / "bayes" / "hypotheses.py", *goals, pkg / "registry.py", pkg / "memo.py",
             *sorted((pkg / "world").glob("*.py")), *sorted((pkg / "intentions").glob("*.py"))]

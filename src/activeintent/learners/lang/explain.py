@@ -16,7 +16,8 @@ import re
 from collections import Counter
 from functools import cache, lru_cache
 
-from activeintent.goals.language import NODES, Goal, all_clauses, nodes, spoken
+from activeintent.goals.goal import Goal, all_clauses
+from activeintent.goals.nodes import NODES, nodes, spoken
 from activeintent.learners.lang.learner import KEEP
 from activeintent.learners.lang.space import goal_space, space_info
 

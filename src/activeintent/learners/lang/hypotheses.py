@@ -18,7 +18,8 @@ import numpy as np
 
 from activeintent.goals import planner
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import Goal, check_language, speaking, spoken
+from activeintent.goals.goal import Goal
+from activeintent.goals.nodes import check_language, speaking, spoken
 from activeintent.goals.prior import FittedPrior, goal_bits, load_prior
 from activeintent.intentions.base import Intention
 from activeintent.learners.bayes.hypotheses import Hypothesis, random_scene

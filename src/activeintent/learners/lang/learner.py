@@ -13,7 +13,8 @@ import numpy as np
 from pydantic import Field
 
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import LATEST, Goal, speaking
+from activeintent.goals.goal import Goal
+from activeintent.goals.nodes import LATEST, speaking
 from activeintent.goals.prior import goal_bits
 from activeintent.learners.base import LearnerContext, Method, RoundRecord
 from activeintent.learners.bayes.judge import HypothesisJudge, trajectory_steps, utility

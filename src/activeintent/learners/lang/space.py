@@ -28,21 +28,19 @@ from pathlib import Path
 import numpy as np
 
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import (
-    NODES,
+from activeintent.goals.goal import (
     QUANTS,
     Each,
     Form,
     Goal,
-    Placed,
     all_clauses,
     parse_goal,
-    speaking,
-    spoken,
     structure_judge,
 )
+from activeintent.goals.nodes import NODES, speaking, spoken
 from activeintent.goals.planner import generic_moves, plan
 from activeintent.goals.prior import FittedPrior, goal_bits
+from activeintent.goals.structures import Placed
 from activeintent.learners.bayes.hypotheses import random_scene
 from activeintent.memo import BoundedCache
 from activeintent.world import WorldState, apply_skill, layout
