@@ -63,7 +63,8 @@ def test_commands_live_in_cli_and_the_library_never_imports_it():
 # package) and from parts of lower layers, at any depth (inside functions and under
 # TYPE_CHECKING too). docs/architecture.md draws the same order.
 LAYERS = (
-    ("registry", "memo", "provenance", "progress_lines", "ranking", "llm"),
+    ("memo",),  # the one in-process cache: every part may keep one
+    ("registry", "provenance", "progress_lines", "ranking", "llm"),
     ("world",),
     ("act", "goals", "protocol", "signals", "sim"),
     ("envs", "intentions", "records", "spec"),

@@ -14,6 +14,7 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 
 from activeintent.goals.facts import Facts
+from activeintent.memo import BoundedCache
 from activeintent.registry import Registry
 from activeintent.world import Skill, WorldState
 
@@ -34,7 +35,7 @@ class Node:
         key = (self.kind, self.key, p, spoken())
         got = _NODE_BITS.get(key)
         if got is None:
-            got = _NODE_BITS[key] = math.log2(len(nodes(self.kind))) + self.param_bits(p)
+            got = _NODE_BITS.put(key, math.log2(len(nodes(self.kind))) + self.param_bits(p))
         return got
 
     def param_bits(self, p: str | None) -> float:
@@ -155,8 +156,11 @@ def speaking(version: int) -> Iterator[int]:
         _SPOKEN.reset(token)
 
 
-_IN_FORCE: dict[tuple[str, int], dict[str, Node]] = {}
-_NODE_BITS: dict[tuple, float] = {}
+# The node types in force by (kind, version), and a node's bits by (kind, key, parameter,
+# version): functions of what is registered, so register() empties both. Sizes hold every
+# entry of every version (some 1,300 bits).
+_IN_FORCE: BoundedCache[tuple[str, int], dict[str, Node]] = BoundedCache(64)
+_NODE_BITS: BoundedCache[tuple, float] = BoundedCache(1 << 16)
 
 
 def nodes(kind: str, version: int | None = None) -> dict[str, Node]:
@@ -165,7 +169,7 @@ def nodes(kind: str, version: int | None = None) -> dict[str, Node]:
     v = spoken() if version is None else version
     got = _IN_FORCE.get((kind, v))
     if got is None:
-        got = _IN_FORCE[(kind, v)] = {k: n for k, n in NODES[kind].items() if n.since <= v}
+        got = _IN_FORCE.put((kind, v), {k: n for k, n in NODES[kind].items() if n.since <= v})
     return got
 
 

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from functools import lru_cache
 
 import numpy as np
 
+from activeintent.memo import memoized
 from activeintent.world import BOUNDS, PutAt, Skill, SkillFailure, WorldState, apply_skill
 
 GRID_STEP = 0.06  # spacing of candidate free points (a block is 4 cm wide)
@@ -28,7 +28,7 @@ def area_points(inside: Callable[[tuple[float, float]], bool], step: float = GRI
     return list(_area_points(inside, step))
 
 
-@lru_cache(maxsize=256)  # a pure function of a fixed grid (the tests are module-level), asked on every planning step
+@memoized(size=256, why="(an area's test, step): a pure function of a fixed grid (the tests are module-level), asked on every planning step")
 def _area_points(inside: Callable[[tuple[float, float]], bool], step: float) -> tuple[tuple[float, float], ...]:
     pts = [p for p in (GRID if step == GRID_STEP else _fine_grid(step)) if inside(p)]
     if not pts:
@@ -38,7 +38,7 @@ def _area_points(inside: Callable[[tuple[float, float]], bool], step: float) -> 
     return tuple(sorted(pts, key=lambda p: (p[0] - cx) ** 2 + (p[1] - cy) ** 2))
 
 
-@lru_cache(maxsize=4)
+@memoized(size=4, why="a pure function of the grid step")
 def _fine_grid(step: float) -> tuple[tuple[float, float], ...]:
     return tuple(grid_points(step))
 

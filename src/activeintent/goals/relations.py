@@ -4,11 +4,10 @@ the unregistered relations the bayes grammar uses (InCell, Flat)."""
 
 from __future__ import annotations
 
-import functools
-
 from activeintent.goals.facts import Facts, facts
 from activeintent.goals.nodes import Relation, register
 from activeintent.goals.planning import GRID, area_points, free_points, nearest_points
+from activeintent.memo import memoized
 from activeintent.world import BLOCK_SIZE, PutIn, PutNextTo, PutOn
 from activeintent.world.colors import COLOR_NAMES, WARM_COLORS
 from activeintent.world.relations import table_position_name
@@ -253,7 +252,7 @@ def _area_points(inside) -> tuple[tuple[float, float], ...]:
     return tuple(area_points(inside))
 
 
-@functools.cache  # planners ask on every step; the grid never changes
+@memoized(size=64, why="a region's name (REGIONS, a constant): planners ask on every step; the grid never changes")
 def _region_points(region: str) -> tuple[tuple[float, float], ...]:
     return _area_points(REGIONS[region])
 

@@ -5,7 +5,6 @@ the bayes grammar use."""
 
 from __future__ import annotations
 
-import functools
 import math
 from itertools import combinations
 
@@ -20,6 +19,7 @@ from activeintent.goals.relations import (
     in_region,
     region_points,
 )
+from activeintent.memo import memoized
 from activeintent.world import BOUNDS, PutIn, PutNextTo, PutOn, Skill
 from activeintent.world.colors import COLOR_NAMES, WARM_COLORS
 from activeintent.world.scene import MIN_SPACING, color_of, kind_of
@@ -894,7 +894,7 @@ PLACE_AREA = {"back-edge": lambda xy: xy[1] > -0.2 - EDGE, "front-edge": lambda 
               "middle": lambda xy: abs(xy[0]) < 0.15 and abs(xy[1] + 0.5) < 0.1}
 
 
-@functools.cache
+@memoized(size=64, why="a place's name (PLACE_AREA, a constant); the grid never changes")
 def place_points(place: str) -> tuple[tuple[float, float], ...]:
     """Grid points of a place, nearest its centre first."""
     return _area_points(PLACE_AREA[place])

@@ -21,7 +21,7 @@ import json
 import math
 import os
 from dataclasses import dataclass
-from functools import cached_property, lru_cache
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -62,7 +62,7 @@ from activeintent.goals.structures import (
     TwoTowersAnyHeights,
 )
 from activeintent.intentions.base import Intention
-from activeintent.memo import BoundedCache
+from activeintent.memo import BoundedCache, memoized
 from activeintent.world import COLOR_NAMES, Scene, Skill, WorldState, layout, sample_scene
 
 SELECTORS = {
@@ -432,7 +432,7 @@ def distinct_names(seed: int = 0, others: int = 6) -> list[str]:
     return names
 
 
-@lru_cache(maxsize=4)
+@memoized(size=4, why="(seed, others): a pure function of them and of the sources (the disk cache's key)")
 def hypothesis_space(seed: int = 0, others: int = 6) -> tuple[Hypothesis, ...]:
     """H: the grammar's hypotheses, deduplicated by behaviour (simplest first)."""
     keep = set(distinct_names(seed, others))
