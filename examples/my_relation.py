@@ -15,8 +15,9 @@ from __future__ import annotations
 import numpy as np
 
 from activeintent.goals.facts import facts
-from activeintent.goals.language import Each, Goal, Relation, region_points, register
+from activeintent.goals.language import Each, Goal, Relation, register
 from activeintent.goals.planner import plan, run
+from activeintent.goals.relations import region_points
 from activeintent.world import PutAt, Scene, WorldState, layout
 from activeintent.world.colors import COLOR_NAMES
 

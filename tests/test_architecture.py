@@ -63,7 +63,8 @@ def test_commands_live_in_cli_and_the_library_never_imports_it():
 # package) and from parts of lower layers, at any depth (inside functions and under
 # TYPE_CHECKING too). docs/architecture.md draws the same order.
 LAYERS = (
-    ("registry", "memo", "provenance", "progress_lines", "ranking", "llm"),
+    ("memo",),  # the one in-process cache: every part may keep one
+    ("registry", "provenance", "progress_lines", "ranking", "llm"),
     ("world",),
     ("act", "goals", "protocol", "signals", "sim"),
     ("envs", "intentions", "records", "spec"),
@@ -75,6 +76,27 @@ LAYERS = (
     ("cli",),
 )
 LAYER = {part: i for i, parts in enumerate(LAYERS) for part in parts}
+
+
+# The parts of goals/, bottom first: a module of goals/ imports only goals modules of lower
+# layers (the goal language's parts show in their order: node kinds, then node types, then goals).
+GOALS_LAYERS = (
+    ("facts", "planning"),
+    ("nodes",),
+    ("selectors", "relations"),
+    ("structures",),
+    ("goal", "requested", "recipes"),
+    ("language", "planner", "prior"),
+)
+
+
+def test_the_goals_modules_import_down_their_layers():
+    layer = {f"activeintent.goals.{m}": i for i, ms in enumerate(GOALS_LAYERS) for m in ms}
+    goals = {name for name in MODULES if name.startswith("activeintent.goals.")}
+    assert goals == set(layer), f"goals modules without a layer: {sorted(goals ^ set(layer))}"
+    upward = sorted((name, imp) for name in goals for imp in imports(MODULES[name])
+                    if imp in layer and layer[imp] >= layer[name])
+    assert not upward, f"goals modules importing sideways or up: {upward}"
 
 
 def part_of(module: str) -> str:
@@ -259,7 +281,7 @@ def test_one_vocabulary_of_goals():
     and nothing else of the learners, and every leaf is built from goals classes."""
     assert not (SRC / "learners" / "bayes" / "behaviours.py").exists()
     grammar = imports(MODULES["activeintent.learners.bayes.hypotheses"])
-    assert {"activeintent.goals.language", "activeintent.goals.recipes"} <= grammar
+    assert {"activeintent.goals.relations", "activeintent.goals.structures", "activeintent.goals.recipes"} <= grammar
     assert not [m for m in grammar if m.startswith("activeintent.learners")], grammar
 
     from activeintent.goals.recipes import Leaf
@@ -273,17 +295,19 @@ def test_one_vocabulary_of_goals():
             assert all(type(p).__module__.startswith("activeintent.goals.") for p in parts), (family, parts)
 
 
-LANGUAGE = str(SRC / "goals" / "language.py")
+# The goal language's parts (goals/language.py is their public face).
+LANGUAGE_PARTS = ("nodes", "selectors", "relations", "structures", "goal")
+LANGUAGE = {str(SRC / "goals" / f"{part}.py") for part in LANGUAGE_PARTS}
 
 
 def _language_calls(call) -> set[str]:
-    """The functions of goals/language.py that ``call()`` runs (nodes judging the state)."""
+    """The functions of the goal language's parts that ``call()`` runs (nodes judging the state)."""
     import sys
 
     seen: set[str] = set()
 
     def profile(frame, event, arg):
-        if event == "call" and frame.f_code.co_filename == LANGUAGE:
+        if event == "call" and frame.f_code.co_filename in LANGUAGE:
             seen.add(frame.f_code.co_name)
 
     sys.setprofile(profile)
@@ -314,7 +338,7 @@ def test_library_and_dev_intentions_take_their_meaning_from_the_goal_language(in
     from activeintent.world.scene import layout
 
     module = type(intention).__module__
-    assert "activeintent.goals.language" in imports(MODULES[module]), module
+    assert {f"activeintent.goals.{part}" for part in LANGUAGE_PARTS} & imports(MODULES[module]), module
     state = WorldState(positions=layout(intention.sample_scene(np.random.default_rng(0)), 0))
     step = (intention.plan(state) or [PutAt(block=state.blocks[0], position="middle")])[0]
     after, failure = apply_skill(state, step)

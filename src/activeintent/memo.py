@@ -7,12 +7,15 @@ never a result). Disk caches (model responses, hypothesis spaces) are not these.
 
 from __future__ import annotations
 
+import functools
+import inspect
 from collections import OrderedDict
 from collections.abc import Callable, Hashable
-from typing import Generic, TypeVar
+from typing import Generic, ParamSpec, TypeVar
 
 K = TypeVar("K", bound=Hashable)
 V = TypeVar("V")
+P = ParamSpec("P")
 
 
 class BoundedCache(Generic[K, V]):
@@ -83,3 +86,63 @@ class IdentityCache(Generic[V]):
 
     def __len__(self) -> int:
         return len(self._cache)
+
+
+_KEYWORDS = object()  # separates positional from keyword arguments in a key
+
+
+def memoized(size: int, why: str) -> Callable[[Callable[P, V]], Callable[P, V]]:
+    """Decorator: keep a pure function's results in a :class:`BoundedCache` of ``size`` entries.
+
+    Key: the call's arguments (hashable; equal arguments share an entry, so ``f(1)`` and
+    ``f(1.0)`` do; the same value passed by keyword is another entry). ``why`` says what the
+    key stands for and what would make an entry wrong (for a pure function of its arguments:
+    nothing, so eviction changes speed only, never a result); it is the wrapper's ``why``. The
+    wrapper's ``cache`` is the BoundedCache (``cache.clear()`` empties it). A function of one
+    parameter is keyed by its argument itself and called with it positionally (the hot
+    helpers: as fast as functools.cache).
+    """
+    if not why.strip():
+        raise ValueError("say what the key is and what would make an entry wrong")
+
+    def wrap(func: Callable[P, V]) -> Callable[P, V]:
+        cache: BoundedCache = BoundedCache(size)
+        data, put = cache._data, cache.put
+        params = list(inspect.signature(func).parameters.values())
+        single = len(params) == 1 and params[0].kind in (inspect.Parameter.POSITIONAL_ONLY,
+                                                         inspect.Parameter.POSITIONAL_OR_KEYWORD)
+
+        if single:
+            @functools.wraps(func)
+            def one(arg):  # type: ignore[no-untyped-def]
+                try:
+                    value = data[arg]
+                except KeyError:
+                    return put(arg, func(arg))
+                try:
+                    data.move_to_end(arg)
+                except KeyError:  # evicted meanwhile by another thread: still the right value
+                    pass
+                return value
+
+            wrapper = one
+        else:
+            @functools.wraps(func)
+            def many(*args, **kwargs):  # type: ignore[no-untyped-def]
+                key = (*args, _KEYWORDS, *kwargs.items()) if kwargs else args
+                try:
+                    value = data[key]
+                except KeyError:
+                    return put(key, func(*args, **kwargs))
+                try:
+                    data.move_to_end(key)
+                except KeyError:
+                    pass
+                return value
+
+            wrapper = many
+        wrapper.cache = cache  # type: ignore[attr-defined]
+        wrapper.why = why  # type: ignore[attr-defined]
+        return wrapper  # type: ignore[return-value]
+
+    return wrap

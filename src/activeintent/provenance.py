@@ -10,9 +10,10 @@ import datetime as dt
 import os
 import platform
 import subprocess
-from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
+
+from activeintent.memo import memoized
 
 # Results folders and scratch runs are written inside the checkout: they do not make it "dirty".
 _NOT_CODE = (":(exclude)docs/results", ":(exclude)runs", ":(exclude,glob)experiments/*/results/**")
@@ -35,7 +36,7 @@ def _git(*args: str) -> str | None:
     return out.stdout.strip()
 
 
-@lru_cache(maxsize=1)
+@memoized(size=1, why="no arguments: the machine's CPU, constant within a process")
 def cpu_model() -> str:
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
@@ -46,7 +47,7 @@ def cpu_model() -> str:
     return platform.processor() or platform.machine()
 
 
-@lru_cache(maxsize=1)
+@memoized(size=1, why="no arguments: the code a result comes from, constant within a process")
 def code_version() -> dict:
     """The code a result comes from (constant within a process)."""
     commit = _git("rev-parse", "HEAD")

@@ -11,11 +11,11 @@ import os
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from functools import cache
 from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
+from activeintent.memo import memoized
 from activeintent.protocol import FORMAT_VERSION
 from activeintent.records import EpisodeResult, dumps
 
@@ -33,7 +33,7 @@ class ErrorRecord(BaseModel):
     error: str = Field(min_length=1)
 
 
-@cache
+@memoized(size=1, why="no arguments: the model class is built once (a pure function of EpisodeResult)")
 def _result_model() -> type[BaseModel]:
     """A results line of a finished episode: its EpisodeResult (without the per-scene tests)
     plus the bench's trial. Strict: a number written as a string is not a number."""

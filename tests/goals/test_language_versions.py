@@ -10,7 +10,16 @@ import pytest
 
 from activeintent.goals import planner
 from activeintent.goals.facts import facts
-from activeintent.goals.language import LATEST, Each, Form, all_clauses, nodes, parse_goal, speaking
+from activeintent.goals.language import (
+    LATEST,
+    NODES,
+    Each,
+    Form,
+    all_clauses,
+    nodes,
+    parse_goal,
+    speaking,
+)
 from activeintent.goals.requested import LIGHTNESS
 from activeintent.learners.lang.hypotheses import LangSpace
 from activeintent.learners.lang.learner import LangConfig, LangLearner
@@ -22,6 +31,21 @@ def _speaks(clause, version: int) -> bool:
     kinds = [("selector", clause.sel)]
     kinds.append(("structure", clause.struct) if isinstance(clause, Form) else ("relation", clause.rel))
     return all(key in nodes(kind, version) for kind, key in kinds)
+
+
+def test_node_types_register_in_their_order():
+    """Registration order is enumeration order (the hypothesis space, committed results): language
+    1's node types in the order of its modules (goals/__init__.py), then language 2's."""
+    assert {kind: list(reg) for kind, reg in NODES.items()} == {
+        "selector": ["all", "colour", "class", "matching", "all-but", "colours", "all-but-colours"],
+        "relation": ["in-bowl", "in-the-bowl", "on-block", "on-the-block", "on-table", "next-to", "side", "region",
+                     "in-bowl-at", "side-of-bowls", "table-part", "in-the-bowl-if-there", "on-the-block-if-there",
+                     "next-to-if-there", "side-if-there", "in-bowl-else", "next-to-bowl-at"],
+        "structure": ["row", "column", "tower", "towers-by-class", "two-towers", "one-bowl", "separate-bowls",
+                      "cluster", "corners", "each-bowl", "around-bowl", "groups-by-class", "stacks", "tower-by-shade",
+                      "row-by-shade", "tower-by-name", "row-by-name", "by-each-bowl", "two-bowls", "bowl-load",
+                      "even-halves"],
+    }
 
 
 def test_language_1_is_the_language_earlier_episodes_ran_in():

@@ -15,22 +15,15 @@ from __future__ import annotations
 import hashlib
 import time
 from abc import ABC, abstractmethod
-from functools import cache
-from importlib.resources import files
 from string import Template
 from typing import Any
 
 from activeintent.act.failures import ExecutionFailure, PlanResult, check_plan
 from activeintent.act.parse import ParseError, parse_instruction
+from activeintent.llm.backend import prompt_template
 from activeintent.llm.base import ChatModel
 from activeintent.world.skills import describe_plan
 from activeintent.world.state import WorldState
-
-
-@cache
-def prompt_template(name: str) -> str:
-    path = files("activeintent") / "prompts" / f"{name}.txt"
-    return path.read_text()
 
 
 def render_prompt(name: str, **values: object) -> tuple[str, str]:

@@ -16,7 +16,6 @@ run generated code unless the user explicitly accepted running without isolation
 
 from __future__ import annotations
 
-import functools
 import os
 import shlex
 import shutil
@@ -26,6 +25,8 @@ import sysconfig
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
+
+from activeintent.memo import memoized
 
 UNSAFE_ENV = "ACTIVEINTENT_UNSAFE_NO_ISOLATION"
 SANDBOX_UID = 65534  # "nobody" inside the user namespace
@@ -171,7 +172,7 @@ def _try(cmd: list[str]) -> str | None:
     return None
 
 
-@functools.lru_cache(maxsize=4)
+@memoized(size=4, why="(bwrap, package root, python, root): wrong only if the sandbox tools change while the process runs")
 def _probe(bwrap: str, package_root: str, python: str, root: bool) -> tuple[bool, str | None, str | None]:
     """(drop_root, problem, note): whether bwrap can start this interpreter isolated."""
     check = [python, "-I", "-S", "-c", "import os; assert os.getuid() == 65534"]

@@ -7,7 +7,6 @@ cannot name an object that is not on the table; the answer is validated again he
 
 from __future__ import annotations
 
-from functools import lru_cache
 from typing import Any, Literal, Union
 
 from pydantic import BaseModel, Field, TypeAdapter, ValidationError, create_model
@@ -15,6 +14,7 @@ from pydantic import BaseModel, Field, TypeAdapter, ValidationError, create_mode
 from activeintent.act.base import Executor, render_prompt
 from activeintent.act.failures import ExecutionFailure, PlanResult
 from activeintent.llm.base import ChatModel, Message, ModelError
+from activeintent.memo import memoized
 from activeintent.world.relations import describe_state
 from activeintent.world.skills import TABLE_POSITIONS, Skill
 from activeintent.world.state import WorldState
@@ -32,7 +32,7 @@ def plan_schema(state: WorldState) -> type[BaseModel]:
     return _schema(tuple(state.blocks), tuple(state.bowls), tuple(state.names))
 
 
-@lru_cache(maxsize=256)
+@memoized(size=256, why="a scene's (blocks, bowls, objects): the answer model is a pure function of them")
 def _schema(blocks: tuple[str, ...], bowls: tuple[str, ...], objects: tuple[str, ...]) -> type[BaseModel]:
     variants: list[type[BaseModel]] = []
     if not blocks:

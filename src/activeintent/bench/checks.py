@@ -18,11 +18,11 @@ from __future__ import annotations
 import datetime as dt
 import re
 import subprocess
-from functools import cache
 from pathlib import Path
 
 from activeintent.bench.legacy import migrated
 from activeintent.bench.work import BenchConfig
+from activeintent.memo import memoized
 from activeintent.protocol import FORMAT_VERSION, trial_seeds
 from activeintent.registry import load_plugin
 from activeintent.runner import check_spec, for_method
@@ -127,7 +127,7 @@ class Plan:
         return None
 
 
-@cache
+@memoized(4096, "a trial's test seed → its test-scene stream: a pure function")
 def _test_stream(test_seed: int) -> int:
     """The test seed an episode records: its test-scene stream (it depends on the trial's test
     seed only, so the episode seed given here does not matter)."""
@@ -158,7 +158,7 @@ def provenance_problem(p: object) -> str | None:
     return None
 
 
-@cache
+@memoized(1, "no key: this code's checkout (it does not move while the process runs)")
 def _checkout() -> Path | None:
     """The git checkout this code runs from, when it is a full one (a shallow clone may lack
     the commits of older results: their commits are then not checked)."""
@@ -171,7 +171,7 @@ def _checkout() -> Path | None:
     return root if out.returncode == 0 and out.stdout.strip() == "false" else None
 
 
-@cache
+@memoized(4096, "a commit id → whether the checkout holds it (a commit once there stays there)")
 def commit_known(commit: str) -> bool:
     """True when this checkout holds the commit, or when there is no full checkout to ask."""
     root = _checkout()

@@ -37,7 +37,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from activeintent.goals.facts import facts
-from activeintent.goals.language import Goal, all_clauses, parse_goal, spoken
+from activeintent.goals.goal import Goal, all_clauses, parse_goal
+from activeintent.goals.nodes import spoken
 from activeintent.goals.planner import generic_moves, plan
 from activeintent.goals.prior import FittedPrior, goal_bits, load_prior
 from activeintent.intentions.base import Intention

@@ -13,7 +13,8 @@ from activeintent.bench.report import plot_success_vs_signals, write_report
 from activeintent.bench.runner import run_bench
 from activeintent.bench.work import BenchConfig
 from activeintent.cli import options as opt
-from activeintent.goals.language import LATEST, parse_goal, speaking
+from activeintent.goals.goal import parse_goal
+from activeintent.goals.nodes import LATEST, speaking
 from activeintent.goals.prior import load_prior
 from activeintent.learners.registry import get_method
 from activeintent.progress_lines import Eta, print_line

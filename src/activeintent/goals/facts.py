@@ -1,7 +1,9 @@
 """Facts: the symbolic relations of one world state in the form hypotheses read quickly.
 
-Computed once per state (and cached), so that hundreds of hypotheses can judge the same
-predicted state without recomputing geometry.
+The record of a state's relations is world.relations' (geometry to relations, in one place);
+Facts index that record (per block: its bowl, below, above; neighbours as a set) with the
+positions and a per-state memo, built once per state (and cached), so that hundreds of
+hypotheses can judge the same predicted state without recomputing anything.
 """
 
 from __future__ import annotations

@@ -22,7 +22,8 @@ from collections.abc import Iterator
 import numpy as np
 
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import REGIONS, Goal, region_points
+from activeintent.goals.goal import Goal
+from activeintent.goals.relations import REGIONS, region_points
 from activeintent.memo import BoundedCache
 from activeintent.world import (
     PutAt,

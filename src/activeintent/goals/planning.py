@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from functools import lru_cache
+from collections.abc import Callable, Iterable
 
 import numpy as np
 
+from activeintent.memo import memoized
 from activeintent.world import BOUNDS, PutAt, Skill, SkillFailure, WorldState, apply_skill
 
 GRID_STEP = 0.06  # spacing of candidate free points (a block is 4 cm wide)
@@ -28,7 +28,7 @@ def area_points(inside: Callable[[tuple[float, float]], bool], step: float = GRI
     return list(_area_points(inside, step))
 
 
-@lru_cache(maxsize=256)  # a pure function of a fixed grid (the tests are module-level), asked on every planning step
+@memoized(size=256, why="(an area's test, step): a pure function of a fixed grid (the tests are module-level), asked on every planning step")
 def _area_points(inside: Callable[[tuple[float, float]], bool], step: float) -> tuple[tuple[float, float], ...]:
     pts = [p for p in (GRID if step == GRID_STEP else _fine_grid(step)) if inside(p)]
     if not pts:
@@ -38,7 +38,7 @@ def _area_points(inside: Callable[[tuple[float, float]], bool], step: float) -> 
     return tuple(sorted(pts, key=lambda p: (p[0] - cx) ** 2 + (p[1] - cy) ** 2))
 
 
-@lru_cache(maxsize=4)
+@memoized(size=4, why="a pure function of the grid step")
 def _fine_grid(step: float) -> tuple[tuple[float, float], ...]:
     return tuple(grid_points(step))
 
@@ -69,9 +69,15 @@ def put_free(
     return None
 
 
-def nearest_points(state: WorldState, block: str) -> list[tuple[float, float]]:
+def nearest_points(state: WorldState, block: str, points: Iterable[tuple[float, float]] = GRID) -> list[tuple[float, float]]:
+    """``points`` (default: the grid), nearest ``block`` first."""
     here = state.pos(block)[:2]
-    return sorted(GRID, key=lambda p: (p[0] - here[0]) ** 2 + (p[1] - here[1]) ** 2)
+    return sorted(points, key=lambda p: (p[0] - here[0]) ** 2 + (p[1] - here[1]) ** 2)
+
+
+def free_points(state: WorldState, pts: Iterable[tuple[float, float]], b: str, n: int = 6) -> list[Skill]:
+    """PutAt skills to the first ``n`` points of ``pts`` (the planner checks they are free)."""
+    return [PutAt(block=b, position=p) for p in list(pts)[:n]]
 
 
 def run(state: WorldState, steps: list[Skill]) -> WorldState | None:

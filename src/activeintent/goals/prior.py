@@ -31,17 +31,9 @@ from pathlib import Path
 
 import numpy as np
 
-from activeintent.goals.language import (
-    MAX_CLAUSES,
-    QUANTS,
-    Each,
-    Form,
-    Goal,
-    check_language,
-    nodes,
-    parse_goal,
-    spoken,
-)
+from activeintent.goals.goal import MAX_CLAUSES, QUANTS, Each, Form, Goal, parse_goal
+from activeintent.goals.nodes import check_language, nodes, spoken
+from activeintent.memo import BoundedCache
 
 ALPHAS = (0.01, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0, 100.0)  # the smoothing strengths tried
 # The priors fitted to data/requests, shipped as package data: one per language version.
@@ -290,7 +282,8 @@ def load_prior(name: str, language: int | None = None) -> FittedPrior | None:
     raise PriorError(f"unknown prior {name!r}; valid priors: length, uniform, fitted, file:PATH")
 
 
-_LOADED: dict[str, FittedPrior] = {}
+# Parsed priors by their JSON text (a pure function of it): the packaged ones and a few files.
+_LOADED: BoundedCache[str, FittedPrior] = BoundedCache(32)
 
 
 def _cached(text: str, where: str) -> FittedPrior:
@@ -300,7 +293,7 @@ def _cached(text: str, where: str) -> FittedPrior:
             data = json.loads(text)
         except ValueError as err:
             raise PriorError(f"{where}: not JSON ({err})") from None
-        got = _LOADED[text] = FittedPrior.from_json(data, where)
+        got = _LOADED.put(text, FittedPrior.from_json(data, where))
     return got
 
 

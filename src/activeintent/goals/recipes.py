@@ -13,20 +13,19 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import (
+from activeintent.goals.nodes import Relation, Structure
+from activeintent.goals.planning import area_points, area_spots, nearest_points, put_free
+from activeintent.goals.relations import REGIONS
+from activeintent.goals.structures import (
     CORNERS,
-    REGIONS,
     Cluster,
     Corners,
     Line,
     OneBowl,
-    Relation,
     SeparateBowls,
-    Structure,
     Tower,
     TowerOnBlock,
 )
-from activeintent.goals.planning import area_points, area_spots, nearest_points, put_free
 from activeintent.world import PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState, apply_skill
 from activeintent.world.scene import ROW_PITCH, kind_of
 

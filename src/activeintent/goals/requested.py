@@ -21,34 +21,33 @@ from __future__ import annotations
 
 from itertools import combinations
 
+# language 1's node types first: registration order is enumeration order (selectors: nothing
+# else here imports them)
+import activeintent.goals.selectors  # noqa: F401,I001
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import (
-    CORNERS,
-    GRID,
-    ORDER_KEYS,
-    PLACE_AREA,
+from activeintent.goals.nodes import Group, Relation, Selector, Structure, register
+from activeintent.goals.planning import GRID, free_points, nearest_points
+from activeintent.goals.relations import (
     REGIONS,
     SIDE_WORDS,
     SIDES,
     Beside,
-    Group,
     InNamedBowl,
     NextTo,
     OnNamedBlock,
     OnTable,
-    Placed,
-    Relation,
-    Row,
-    Selector,
-    Structure,
-    Tower,
-    _near_first,
-    _towers,
-    bowl_counts,
-    free_points,
     in_region,
     region_points,
-    register,
+)
+from activeintent.goals.structures import (
+    CORNERS,
+    ORDER_KEYS,
+    PLACE_AREA,
+    Placed,
+    Row,
+    Tower,
+    _towers,
+    bowl_counts,
 )
 from activeintent.world import PutIn, PutNextTo, PutOn, Skill
 from activeintent.world.colors import COLOR_NAMES, COLORS
@@ -181,7 +180,7 @@ class SideOfBowls(Relation):
         if not bowls:
             return []
         pts = [q for q in GRID if all(Beside.beyond(q, state.pos(w)[:2], w, p) for w in bowls)]
-        return free_points(state, _near_first(state, b, pts), b, 8)
+        return free_points(state, nearest_points(state, b, pts), b, 8)
 
 
 EDGES = ("back-edge", "front-edge", "left-edge", "right-edge")
@@ -212,7 +211,7 @@ class TablePart(Relation):
             pts = [q for c in CORNERS for q in region_points(c)[:3]]
         else:
             pts = [q for q in GRID if any(PLACE_AREA[e](q) for e in EDGES)]
-        return free_points(state, _near_first(state, b, pts), b, 8)
+        return free_points(state, nearest_points(state, b, pts), b, 8)
 
 
 class IfThere(Relation):
@@ -416,7 +415,7 @@ class TowerByShade(Tower):
         want = sorted(g, key=ORDER_KEYS[p])
         n = self._ordered(f, g, p)
         if n == 0:
-            return free_points(state, _near_first(state, want[0], GRID), want[0], 6)
+            return free_points(state, nearest_points(state, want[0]), want[0], 6)
         return [PutOn(block=want[n], target=want[n - 1])] if n < len(want) else []
 
 
@@ -442,7 +441,7 @@ class RowByShade(Row):
         want = sorted(g, key=ORDER_KEYS[p])
         k = max((n for n in range(1, len(want) + 1) if self.line(f, tuple(want[:n]), p)), default=0)
         if k == 0:
-            return free_points(state, _near_first(state, want[0], GRID), want[0], 4)
+            return free_points(state, nearest_points(state, want[0]), want[0], 4)
         if k < len(want):
             return [PutNextTo(block=want[k], target=want[k - 1], side="right")]
         return []

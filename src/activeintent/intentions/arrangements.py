@@ -18,12 +18,13 @@ from itertools import combinations
 import numpy as np
 
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import BottomOfTower, ColourClass, Column, InBowl, Line, Row, Tower
-from activeintent.goals.language import TwoTowers as TwoTowersNode
+from activeintent.goals.relations import InBowl
+from activeintent.goals.selectors import ColourClass
+from activeintent.goals.structures import BottomOfTower, Column, Line, Row, Tower
+from activeintent.goals.structures import TwoTowers as TwoTowersNode
 from activeintent.intentions.base import Intention
 from activeintent.intentions.blockwise import BlockwiseIntention
 from activeintent.intentions.placement import (
-    ROW_PITCH,
     TABLE_INNER,
     grid,
     is_clear,
@@ -49,6 +50,7 @@ from activeintent.world import (
     apply_skill,
     relations,
 )
+from activeintent.world.scene import ROW_PITCH
 
 
 def _two_to_four_blocks(rng: np.random.Generator) -> Scene:

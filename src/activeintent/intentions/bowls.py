@@ -10,8 +10,9 @@ from __future__ import annotations
 import numpy as np
 
 from activeintent.goals.facts import facts
-from activeintent.goals.language import InBowl, NextTo, OnTable, SeparateBowls, own_bowl
-from activeintent.goals.language import OneBowl as OneBowlNode
+from activeintent.goals.relations import InBowl, NextTo, OnTable
+from activeintent.goals.structures import OneBowl as OneBowlNode
+from activeintent.goals.structures import SeparateBowls
 from activeintent.intentions.blockwise import BlockwiseIntention
 from activeintent.intentions.placement import free_spot
 from activeintent.world import (
@@ -25,7 +26,7 @@ from activeintent.world import (
     relations,
 )
 from activeintent.world.predict import apply_skill
-from activeintent.world.scene import color_of
+from activeintent.world.scene import color_of, own_bowl
 
 
 def _colors(rng: np.random.Generator, n: int, exclude: tuple[str, ...] | list[str] = ()) -> list[str]:

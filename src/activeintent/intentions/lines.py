@@ -2,7 +2,7 @@
 
 The held-out suites' rows are this line (heldout2 asks ``line_ok``): they must not depend on
 the goal language (activeintent.goals), which the library's align now takes its row from
-(goals.language.Row with ``loaded``: the same row, checked block for block).
+(goals.structures.Row with ``loaded``: the same row, checked block for block).
 """
 
 from __future__ import annotations

@@ -22,7 +22,6 @@ from activeintent.world import (
     relations,
 )
 from activeintent.world.predict import SkillFailure, apply_skill, target_position
-from activeintent.world.scene import ROW_PITCH as ROW_PITCH  # the suites read it here
 from activeintent.world.scene import color_of
 
 if TYPE_CHECKING:

@@ -12,7 +12,9 @@ from __future__ import annotations
 import numpy as np
 
 from activeintent.goals.facts import facts
-from activeintent.goals.language import CORNER_CELL, ColourClass, Corners, InRegion
+from activeintent.goals.relations import CORNER_CELL, InRegion
+from activeintent.goals.selectors import ColourClass
+from activeintent.goals.structures import Corners
 from activeintent.intentions.blockwise import BlockwiseIntention
 from activeintent.intentions.placement import TABLE_INNER, free_spot, grid, nearest_first
 from activeintent.world import (

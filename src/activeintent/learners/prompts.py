@@ -7,18 +7,9 @@ its text, so the response cache never serves an answer made for an older prompt.
 from __future__ import annotations
 
 import hashlib
-from functools import cache
-from importlib.resources import files
 from string import Template
 
-
-@cache
-def template_text(name: str) -> str:
-    path = files("activeintent") / "prompts" / f"{name}.txt"
-    if not path.is_file():
-        available = sorted(p.name[:-4] for p in (files("activeintent") / "prompts").iterdir() if p.name.endswith(".txt"))
-        raise FileNotFoundError(f"No prompt template {name!r}; available: {', '.join(available)}")
-    return path.read_text()
+from activeintent.llm.backend import prompt_template as template_text
 
 
 def render(name: str, **values: object) -> str:

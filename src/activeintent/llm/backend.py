@@ -7,8 +7,7 @@ import json
 import re
 import time
 from abc import ABC, abstractmethod
-from functools import cache
-from pathlib import Path
+from importlib.resources import files
 from typing import Any
 
 from pydantic import BaseModel, ValidationError
@@ -25,13 +24,19 @@ from activeintent.llm.base import (
     T,
     TextPart,
 )
+from activeintent.memo import memoized
 
-_PROMPTS = Path(__file__).resolve().parent.parent / "prompts"
 
-
-@cache
+@memoized(size=64, why="a template's name: the package's prompt files do not change while the process runs")
 def prompt_template(name: str) -> str:
-    return (_PROMPTS / f"{name}.txt").read_text(encoding="utf-8")
+    """The text of prompt template ``name`` (package data: activeintent/prompts/NAME.txt), read
+    once; an unknown name lists the known ones. The one reader of the templates."""
+    folder = files("activeintent") / "prompts"
+    path = folder / f"{name}.txt"
+    if not path.is_file():
+        available = sorted(p.name[:-4] for p in folder.iterdir() if p.name.endswith(".txt"))
+        raise FileNotFoundError(f"No prompt template {name!r}; available: {', '.join(available)}")
+    return path.read_text(encoding="utf-8")
 
 
 class ChatRequest(BaseModel):

@@ -11,7 +11,6 @@ from __future__ import annotations
 import json
 import os
 import threading
-from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +25,7 @@ from activeintent.llm.base import (
     StructuredOutputError,
 )
 from activeintent.llm.grammar_greedy import GrammarFirstGreedy, GrammarFirstSampling
+from activeintent.memo import memoized
 
 # ggml waits at an OpenMP barrier after every operation. libgomp's default spin (300,000 turns)
 # holds a core another process may need (a learner-sized call took 4.4 s with one core busy);
@@ -235,7 +235,7 @@ def _loosen(node: object) -> object:
     return node
 
 
-@lru_cache(maxsize=64)
+@memoized(size=64, why="a JSON schema's text: a pure function of it (and of the installed llama-cpp)")
 def _grammar_text(schema_json: str) -> str:
     """GBNF for a JSON schema (property order kept: the model writes fields in that order)."""
     from llama_cpp.llama_grammar import json_schema_to_gbnf

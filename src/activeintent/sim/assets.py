@@ -7,11 +7,10 @@ renderer asks for visual-only bodies, which are cheaper.
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
 import pybullet as p
 
+from activeintent.memo import memoized
 from activeintent.world.colors import COLORS
 from activeintent.world.scene import (
     BLOCK_SIZE,
@@ -34,7 +33,7 @@ BOWL_FLAT_RADIUS = 0.035  # inner floor is flat out to here (a block's half diag
 BOWL_SEGMENTS = 32
 
 
-@lru_cache(maxsize=1)
+@memoized(size=1, why="no arguments: a pure function of the bowl's constants")
 def bowl_mesh() -> tuple[np.ndarray, np.ndarray]:
     """Vertices [V, 3] and triangle indices [F*3] of a closed bowl (surface of revolution).
 

@@ -11,7 +11,6 @@ Names of every suite resolve everywhere an intention name is accepted. Suites ar
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -24,6 +23,7 @@ from activeintent.intentions.registry import (
     get_intention,
     resolve_intention,
 )
+from activeintent.memo import memoized
 from activeintent.registry import Registry, UnknownName
 from activeintent.suites.dev import dev_intentions
 from activeintent.suites.heldout import heldout_intentions
@@ -83,7 +83,7 @@ def is_held_out(suite_name: str) -> bool:
     return suite_name in SUITES and SUITES[suite_name].held_out
 
 
-@functools.cache
+@memoized(size=64, why="a suite's intention names by suite name: its loader reads files that do not change while the process runs")
 def _names(suite_name: str) -> tuple[str, ...]:
     return tuple(SUITES[suite_name].load())
 

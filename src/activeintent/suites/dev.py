@@ -23,16 +23,17 @@ from collections.abc import Callable, Iterable, Iterator
 import numpy as np
 
 from activeintent.goals.facts import facts, is_warm
-from activeintent.goals.language import (
+from activeintent.goals.relations import InBowl, OnBlock
+from activeintent.goals.selectors import ColourClass
+from activeintent.goals.structures import (
+    EDGE,
     RED_TO_PURPLE,
+    SEVEN_RAINBOW_COLOURS,
     AroundBowl,
     ClassGroupsApart,
     Cluster,
-    ColourClass,
     Column,
-    InBowl,
     LineWithin,
-    OnBlock,
     Row,
     SameCorner,
     SeparateBowls,
@@ -43,7 +44,6 @@ from activeintent.goals.language import (
 from activeintent.intentions.base import Intention
 from activeintent.intentions.blockwise import BlockwiseIntention
 from activeintent.intentions.placement import (
-    ROW_PITCH,
     TABLE_INNER,
     free_spot,
     grid,
@@ -70,12 +70,11 @@ from activeintent.world import (
     apply_skill,
     relations,
 )
-from activeintent.world.scene import color_of
+from activeintent.world.scene import ROW_PITCH, color_of
 from activeintent.world.skills import TABLE_POSITIONS
 
 CENTRE = np.array([0.0, -0.5])
 CORNERS = ("top left corner", "top right corner", "bottom left corner", "bottom right corner")
-SEVEN_RAINBOW_COLOURS = ("red", "orange", "yellow", "green", "cyan", "blue", "purple")
 SIDES = ("nearest", "left", "right", "front", "behind")
 
 
@@ -673,8 +672,8 @@ class TowerBesideBowl(Intention):
 
 # "Along the left edge": block centres at most 10 cm from the table's left edge (x = -0.3), so
 # a column in the left third but nearer the middle of the table does not count
-# (goals.language.along_left_edge).
-LEFT_EDGE_X = BOUNDS[0][0] + 0.10
+# (goals.structures.along_left_edge).
+LEFT_EDGE_X = BOUNDS[0][0] + EDGE
 
 
 def _by_left_edge(state: WorldState, block: str) -> bool:

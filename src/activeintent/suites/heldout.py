@@ -28,7 +28,6 @@ from activeintent.intentions.base import Intention
 from activeintent.intentions.blockwise import BlockwiseIntention
 from activeintent.intentions.placement import (
     LINE_TOL,
-    ROW_PITCH,
     free_spot,
     grid,
     is_clear,
@@ -57,7 +56,7 @@ from activeintent.world import (
     relations,
     sample_scene,
 )
-from activeintent.world.scene import color_of
+from activeintent.world.scene import MIN_SPACING, ROW_PITCH, color_of
 
 # Blocks are put at least this far inside the 60 cm square, so that no block hangs over it.
 EDGE_INSET = 0.02
@@ -67,7 +66,6 @@ CENTRE = np.array([0.0, -0.5])
 FRONT_BAND_Y = -0.70  # "along the front edge": within 10 cm of it
 BACK_HALF_Y = -0.5
 CENTRE_RADIUS = 0.15  # "in the middle of the table": within 15 cm of its centre
-MIN_SPACING = 0.03  # two blocks in a line closer than this would overlap
 # "In front of a bowl": the block's offset from the bowl points forward within about 45°;
 # the slack absorbs the few millimetres by which the simulator settles a block.
 CONE_SLACK = 0.02

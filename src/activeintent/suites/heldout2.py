@@ -49,7 +49,6 @@ from activeintent.intentions.blockwise import BlockwiseIntention
 from activeintent.intentions.lines import StraightLine as Align
 from activeintent.intentions.placement import (
     LINE_TOL,
-    ROW_PITCH,
     TABLE_INNER,
     free_spot,
     grid,
@@ -77,7 +76,7 @@ from activeintent.world import (
     apply_skill,
     relations,
 )
-from activeintent.world.scene import color_of
+from activeintent.world.scene import ROW_PITCH, color_of
 
 BACK_Y = -0.31  # a block "along the back edge": centre within 11 cm of it (y = -0.2)
 FRONT_Y = -0.69  # a block "along the front edge": centre within 11 cm of it (y = -0.8)

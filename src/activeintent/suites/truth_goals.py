@@ -52,24 +52,15 @@ import hashlib
 import json
 import sys
 from collections import Counter
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from activeintent.goals.facts import facts
-from activeintent.goals.language import (
-    MAX_CLAUSES,
-    QUANTS,
-    Each,
-    Form,
-    Goal,
-    all_clauses,
-    nodes,
-    parse_goal,
-    speaking,
-)
+from activeintent.goals.goal import MAX_CLAUSES, QUANTS, Each, Form, Goal, all_clauses, parse_goal
+from activeintent.goals.nodes import nodes, speaking
 from activeintent.learners.lang.hypotheses import GoalIntention
+from activeintent.memo import memoized
 from activeintent.protocol import (
     DEFAULT_TEST_POOL,
     DEFAULT_TEST_SCENES,
@@ -148,13 +139,13 @@ def random_goal(rng: np.random.Generator) -> Goal:
 # ---- the filter ------------------------------------------------------------------------------
 
 
-@lru_cache(maxsize=2)
+@memoized(size=2, why="a pure function of (seed, n): the protocol's scene draws and layouts")
 def scene_sample(seed: int = SCENE_SEED, n: int = SCENES) -> tuple[tuple[Scene, WorldState], ...]:
     """The fixed sample of the protocol's test scenes, each with its initial state."""
     return tuple((scene, WorldState(positions=layout(scene, lseed))) for scene, lseed in draw_test_scenes(seed, n))
 
 
-@lru_cache(maxsize=1)
+@memoized(size=1, why="no arguments: a pure function of the protocol's seeds and defaults")
 def default_pools() -> tuple[tuple[Scene, ...], ...]:
     """The scenes scored at k = K in each trial of a default bench (bench seed 0): the test
     seed depends on the trial only, not on the intention."""
@@ -260,7 +251,7 @@ def draw(seed: int = SEED, count: int = COUNT) -> dict:
 # ---- the committed suite ---------------------------------------------------------------------
 
 
-@lru_cache(maxsize=1)
+@memoized(size=1, why="the committed truth_goals.json: wrong only if the file changes while the process runs")
 def committed() -> dict:
     """The committed ``truth_goals.json``."""
     return json.loads(PATH.read_text())

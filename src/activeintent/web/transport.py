@@ -35,6 +35,7 @@ import uvicorn
 from starlette.types import ASGIApp, Receive, Scope, Send
 from uvicorn.protocols.http.h11_impl import H11Protocol
 
+from activeintent.memo import BoundedCache
 from activeintent.web.errors import RateLimitedLog, error_body
 
 log = logging.getLogger("activeintent.web")
@@ -279,7 +280,9 @@ class QuietRepeats(logging.Filter):
     def __init__(self, every: float = 10.0, clock=time.monotonic):
         super().__init__()
         self.every, self.clock = every, clock
-        self._last: dict[str, float] = {}
+        # when each message last passed, by its first 200 characters; messages are templates, but
+        # the memory is bounded anyway (a forgotten message passes again)
+        self._last: BoundedCache[str, float] = BoundedCache(256)
         self._skipped: Counter[str] = Counter()
 
     def filter(self, record: logging.LogRecord) -> bool:
@@ -289,9 +292,7 @@ class QuietRepeats(logging.Filter):
         if last is not None and now - last < self.every:
             self._skipped[key] += 1
             return False
-        if len(self._last) > 256:  # messages are templates, but bound the memory anyway
-            self._last.clear()
-        self._last[key] = now
+        self._last.put(key, now)
         skipped = self._skipped.pop(key, 0)
         if skipped:
             record.msg = f"{record.msg} (and {skipped} more like it in the last {now - last:.0f} s)"

@@ -7,12 +7,12 @@ workspace x ∈ [-0.3, 0.3] (left → right), y ∈ [-0.8, -0.2] (bottom → top
 from __future__ import annotations
 
 import difflib
-import functools
 from typing import Literal, NamedTuple
 
 import numpy as np
 from pydantic import BaseModel, field_validator
 
+from activeintent.memo import memoized
 from activeintent.world.colors import COLOR_NAMES
 
 BOUNDS = ((-0.3, 0.3), (-0.8, -0.2))
@@ -57,14 +57,19 @@ class ObjectName(NamedTuple):
         )
 
 
-@functools.cache  # asked millions of times about the same few names
+@memoized(size=4096, why="an object's name (a pure function): asked millions of times about the same few names")
 def kind_of(name: str) -> str:
     return name.rsplit(" ", 1)[-1]
 
 
-@functools.cache
+@memoized(size=4096, why="an object's name (a pure function): asked millions of times about the same few names")
 def color_of(name: str) -> str:
     return name.split(" ", 1)[0]
+
+
+def own_bowl(block: str) -> str:
+    """The bowl of ``block``'s colour."""
+    return f"{color_of(block)} bowl"
 
 
 def footprint_radius(name: str) -> float:

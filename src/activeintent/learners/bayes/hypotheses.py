@@ -21,30 +21,12 @@ import json
 import math
 import os
 from dataclasses import dataclass
-from functools import cached_property, lru_cache
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 
 from activeintent.goals.facts import Facts, facts, is_cool, is_warm
-from activeintent.goals.language import (
-    Cluster,
-    Column,
-    Corners,
-    Flat,
-    InBowl,
-    InCell,
-    InNamedBowl,
-    InRegion,
-    NextTo,
-    OneBowl,
-    OnTable,
-    Row,
-    SeparateBowls,
-    Tower,
-    TowerOnBlock,
-    TwoTowersAnyHeights,
-)
 from activeintent.goals.planning import run
 from activeintent.goals.recipes import (
     EveryBlock,
@@ -59,8 +41,28 @@ from activeintent.goals.recipes import (
     Stack,
     TwoStacks,
 )
+from activeintent.goals.relations import (
+    Flat,
+    InBowl,
+    InCell,
+    InNamedBowl,
+    InRegion,
+    NextTo,
+    OnTable,
+)
+from activeintent.goals.structures import (
+    Cluster,
+    Column,
+    Corners,
+    OneBowl,
+    Row,
+    SeparateBowls,
+    Tower,
+    TowerOnBlock,
+    TwoTowersAnyHeights,
+)
 from activeintent.intentions.base import Intention
-from activeintent.memo import BoundedCache
+from activeintent.memo import BoundedCache, memoized
 from activeintent.world import COLOR_NAMES, Scene, Skill, WorldState, layout, sample_scene
 
 SELECTORS = {
@@ -381,7 +383,8 @@ def _cache_sources() -> list[Path]:
     recipes its leaves are (and the facts, placing helpers and node registry they are built on),
     all of world/, intentions/."""
     pkg = Path(__file__).resolve().parents[2]
-    goals = [pkg / "goals" / name for name in ("__init__.py", "facts.py", "language.py", "planning.py", "recipes.py",
+    goals = [pkg / "goals" / name for name in ("__init__.py", "facts.py", "nodes.py", "selectors.py", "relations.py",
+                                                "structures.py", "goal.py", "language.py", "planning.py", "recipes.py",
                                                 "requested.py")]
     return [pkg / "learners" / "bayes" / "hypotheses.py", *goals, pkg / "registry.py", pkg / "memo.py",
             *sorted((pkg / "world").glob("*.py")), *sorted((pkg / "intentions").glob("*.py"))]
@@ -429,7 +432,7 @@ def distinct_names(seed: int = 0, others: int = 6) -> list[str]:
     return names
 
 
-@lru_cache(maxsize=4)
+@memoized(size=4, why="(seed, others): a pure function of them and of the sources (the disk cache's key)")
 def hypothesis_space(seed: int = 0, others: int = 6) -> tuple[Hypothesis, ...]:
     """H: the grammar's hypotheses, deduplicated by behaviour (simplest first)."""
     keep = set(distinct_names(seed, others))

@@ -14,11 +14,12 @@ from __future__ import annotations
 import math
 import re
 from collections import Counter
-from functools import cache, lru_cache
 
-from activeintent.goals.language import NODES, Goal, all_clauses, nodes, spoken
+from activeintent.goals.goal import Goal, all_clauses
+from activeintent.goals.nodes import NODES, nodes, speaking, spoken
 from activeintent.learners.lang.learner import KEEP
 from activeintent.learners.lang.space import goal_space, space_info
+from activeintent.memo import memoized
 
 MIN_SCORE = 0.45
 STOP = {"the", "a", "an", "is", "are", "be", "should", "to", "of", "on", "in", "and", "it", "its", "their",
@@ -47,9 +48,10 @@ def words(text: str) -> list[str]:
     return out
 
 
-@lru_cache(maxsize=1)
-def _index() -> tuple[list[Goal], list[Counter], dict[str, float]]:
-    goals = [Goal((c,)) for c in all_clauses()]
+@memoized(size=4, why="a language version: its one-clause goals and their words (the nodes registered by then)")
+def _index(language: int) -> tuple[list[Goal], list[Counter], dict[str, float]]:
+    with speaking(language):
+        goals = [Goal((c,)) for c in all_clauses()]
     bags = [Counter(words(re.sub(r"\(.*?\)", "", g.sentence()))) for g in goals]
     df: Counter = Counter()
     for b in bags:
@@ -84,17 +86,19 @@ ORDER_WEIGHT = 0.05
 
 
 def _matches(text: str, n: int) -> list[tuple[float, Goal]]:
-    goals, bags, idf = _index()
+    language = spoken()
+    goals, bags, idf = _index(language)
     seq = words(text)
     q = Counter(seq)
-    scored = sorted(((_sim(q, b, idf) - ORDER_WEIGHT * (1 - word_order(seq, _sequence(i))), -g.bits, i)
+    scored = sorted(((_sim(q, b, idf) - ORDER_WEIGHT * (1 - word_order(seq, _sequence(language, i))), -g.bits, i)
                      for i, (g, b) in enumerate(zip(goals, bags, strict=True))), reverse=True)[:n]
     return [(s, goals[i]) for s, _, i in scored]
 
 
-@cache
-def _sequence(i: int) -> list[str]:
-    return words(re.sub(r"\(.*?\)", "", _index()[0][i].sentence()))
+# every clause of the largest language (229,080) is asked for on every match: all kept
+@memoized(size=1 << 19, why="(language version, clause index): the words of that clause's sentence")
+def _sequence(language: int, i: int) -> list[str]:
+    return words(re.sub(r"\(.*?\)", "", _index(language)[0][i].sentence()))
 
 
 def explain(sentence: str, n: int = 5) -> dict:

@@ -18,7 +18,8 @@ import numpy as np
 
 from activeintent.goals import planner
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import Goal, check_language, speaking, spoken
+from activeintent.goals.goal import Goal
+from activeintent.goals.nodes import check_language, speaking, spoken
 from activeintent.goals.prior import FittedPrior, goal_bits, load_prior
 from activeintent.intentions.base import Intention
 from activeintent.learners.bayes.hypotheses import Hypothesis, random_scene
@@ -155,7 +156,9 @@ class GoalIntention(Intention):
         return planner.plan(self.goal, state)
 
 
-_SPACES: dict[tuple[int, int, str, int], LangSpace] = {}
+# By (seed, keep, prior's tag, language): a space is a pure function of them (and of the sources);
+# its planner verdicts are reset per episode. A process uses one or two.
+_SPACES: BoundedCache[tuple[int, int, str, int], LangSpace] = BoundedCache(16)
 
 
 def lang_space(seed: int = 0, keep: int = 3000, prior: str = "length", language: int | None = None) -> LangSpace:
@@ -165,6 +168,5 @@ def lang_space(seed: int = 0, keep: int = 3000, prior: str = "length", language:
     language = spoken() if language is None else check_language(language)
     fitted = load_prior(prior, language)
     key = (seed, keep, fitted.tag if fitted else "length", language)
-    if key not in _SPACES:
-        _SPACES[key] = LangSpace(goal_space(seed, keep, fitted, language), prior=fitted, language=language)
-    return _SPACES[key]
+    return _SPACES.get_or_make(key, lambda: LangSpace(goal_space(seed, keep, fitted, language), prior=fitted,
+                                                      language=language))

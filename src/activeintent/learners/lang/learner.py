@@ -13,7 +13,8 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import LATEST, Goal, check_language, speaking
+from activeintent.goals.goal import Goal
+from activeintent.goals.nodes import LATEST, check_language, speaking
 from activeintent.goals.prior import goal_bits, load_prior
 from activeintent.learners.base import LearnerContext, Method, RoundRecord
 from activeintent.learners.bayes.judge import HypothesisJudge, trajectory_steps, utility

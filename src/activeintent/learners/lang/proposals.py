@@ -24,7 +24,8 @@ from typing import Literal
 
 from pydantic import BaseModel, Field, create_model
 
-from activeintent.goals.language import MAX_CLAUSES, QUANTS, Each, Form, Goal, nodes
+from activeintent.goals.goal import MAX_CLAUSES, QUANTS, Each, Form, Goal
+from activeintent.goals.nodes import nodes
 from activeintent.learners.prompts import render
 from activeintent.llm.base import ChatModel, Message
 from activeintent.world.colors import COLOR_NAMES

@@ -22,29 +22,26 @@ import json
 import os
 import time
 from collections.abc import Callable
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from activeintent.goals.facts import Facts, facts
-from activeintent.goals.language import (
-    NODES,
+from activeintent.goals.goal import (
     QUANTS,
     Each,
     Form,
     Goal,
-    Placed,
     all_clauses,
     parse_goal,
-    speaking,
-    spoken,
     structure_judge,
 )
+from activeintent.goals.nodes import NODES, speaking, spoken
 from activeintent.goals.planner import generic_moves, plan
 from activeintent.goals.prior import FittedPrior, goal_bits
+from activeintent.goals.structures import Placed
 from activeintent.learners.bayes.hypotheses import random_scene
-from activeintent.memo import BoundedCache
+from activeintent.memo import BoundedCache, memoized
 from activeintent.world import WorldState, apply_skill, layout
 from activeintent.world.scene import kind_of
 
@@ -536,7 +533,7 @@ def goal_space(seed: int = 0, keep: int = 3000, prior: FittedPrior | None = None
     return _goal_space(seed, keep, prior, spoken() if language is None else language)
 
 
-@lru_cache(maxsize=4)
+@memoized(size=4, why="(seed, keep, prior, language): a pure function of them and of the sources (the disk cache's key)")
 def _goal_space(seed: int, keep: int, prior: FittedPrior | None, language: int) -> tuple[Goal, ...]:
     return tuple(parse_goal(k) for k in space_info(seed, keep, prior, language)["keys"])
 

@@ -12,8 +12,6 @@
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from activeintent import ranking
@@ -23,6 +21,7 @@ from activeintent.learners.bayes.belief import Belief
 from activeintent.learners.bayes.candidates import Outcome, candidate_plans
 from activeintent.learners.bayes.hypotheses import hypothesis_space
 from activeintent.learners.reward.features import N_FEATURES, phi
+from activeintent.memo import memoized
 from activeintent.world import PutAt, PutIn, PutNextTo, PutOn, Skill, WorldState, apply_skill
 from activeintent.world.skills import TABLE_POSITIONS
 
@@ -50,7 +49,7 @@ def _key(state: WorldState) -> tuple:
     return tuple((n, float(p[0]), float(p[1]), float(p[2])) for n, p in state.positions.items())
 
 
-@functools.lru_cache(maxsize=4096)
+@memoized(size=4096, why="a state's exact positions: its successors are a pure function of them")
 def _succ_cached(key: tuple) -> tuple:
     state = WorldState(positions={n: (x, y, z) for n, x, y, z in key})
     out = []
@@ -151,7 +150,7 @@ def planner_plans(pool: Pool, rng: np.random.Generator, limit: int = 24, prefixe
         pool.add(o.plan)
 
 
-@functools.cache
+@memoized(size=1, why="no arguments: the length prior over the bayes hypothesis space (seed 0)")
 def _prior():
     b = Belief(tuple(hypothesis_space(0)), "length")
     return b.hyps, b.weights

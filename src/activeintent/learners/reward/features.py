@@ -17,11 +17,10 @@ of a tower, of a touching group of blocks.
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from activeintent.goals.facts import ALIGN_TOL, Facts, facts
+from activeintent.memo import memoized
 from activeintent.world import WorldState
 from activeintent.world.colors import COLOR_NAMES, COOL_COLORS, WARM_COLORS
 from activeintent.world.relations import _GRID
@@ -44,7 +43,7 @@ FEATURE_NAMES: tuple[str, ...] = tuple(f"{c}:{r}" for c in CLASSES for r in RELA
 N_FEATURES = len(FEATURE_NAMES)
 
 
-@functools.cache
+@memoized(size=64, why="a colour: a pure function of it (the mask is shared: callers must not change it)")
 def _class_mask(color: str) -> np.ndarray:
     """Which classes a block of ``color`` belongs to."""
     m = np.zeros(len(CLASSES), bool)
