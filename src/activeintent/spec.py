@@ -25,6 +25,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from pydantic.fields import FieldInfo
 
+from activeintent.llm.models import ModelsConfig
 from activeintent.protocol import (
     DEFAULT_BUDGET,
     DEFAULT_TEST_POOL,
@@ -81,20 +82,6 @@ class ProtocolConfig(BaseModel):
     def seeds(self) -> EpisodeSeeds:
         """The one split of ``seed`` (and ``test_seed``) into the episode's named streams."""
         return EpisodeSeeds.from_seed(self.seed, self.test_seed)
-
-
-class ModelsConfig(BaseModel):
-    """Which models answer (specs as in docs/models.md) and how their replies are cached."""
-
-    model_config = ConfigDict(extra="forbid")
-
-    llm: str = Field("embedded", description="LLM: embedded | gguf:/path.gguf | openai:<model> | none (Bayesian methods "
-                     "and baselines)")
-    vlm: str | None = Field(None, description="Multimodal model spec for the retriever (default: the LLM)")
-    base_url: str | None = Field(None, description="OpenAI-compatible endpoint",
-                                 json_schema_extra={"envvar": "OPENAI_BASE_URL"})
-    cache: str | None = Field(None, description="Response cache file (SQLite); default ~/.cache/activeintent")
-    cache_mode: str = Field("record", pattern="^(record|replay|off)$", description="record | replay | off")
 
 
 class LearnerSpec(BaseModel):

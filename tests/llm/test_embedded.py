@@ -249,8 +249,7 @@ def test_the_planner_gets_its_own_kv_cache_and_the_context_is_the_ggufs(gguf_pat
     learner's conversation and the planner's fixed prompt each keep their prefix; counted in
     the run's usage."""
     from activeintent.llm.embedded import gguf_context_length
-    from activeintent.runner import EXECUTOR_CTX, Models
-    from activeintent.spec import ModelsConfig
+    from activeintent.llm.models import EXECUTOR_CTX, Models, ModelsConfig
 
     assert gguf_context_length(gguf_path) == 32768
     models = Models(ModelsConfig(llm="embedded", cache_mode="off"))

@@ -7,8 +7,9 @@ from fault_server import FaultServer, Ok
 
 from activeintent.llm.accounting import CallRecord, Usage
 from activeintent.llm.base import Message
+from activeintent.llm.models import Models
 from activeintent.llm.registry import load_model, parse_spec
-from activeintent.runner import Models, RunSpec, check_spec
+from activeintent.runner import RunSpec, check_spec
 
 
 @pytest.mark.parametrize(

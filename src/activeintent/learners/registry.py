@@ -6,7 +6,7 @@ learner with ``METHODS.register("name", Method(...))`` in a file passed with ``-
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 
 from activeintent.learners.base import Learner, LearnerContext, Method
 from activeintent.learners.bayes.learner import (
@@ -20,7 +20,7 @@ from activeintent.learners.lang.learner import lang_method, lang_zero_signal
 from activeintent.learners.paper import faithful as f
 from activeintent.learners.paper import structured as p
 from activeintent.learners.reward.learner import RewardLearner
-from activeintent.registry import Registry, UnknownName
+from activeintent.registry import Registry, UnknownName, load_plugin
 from activeintent.signals import SIGNALS
 
 METHODS: Registry[Method] = Registry("method")
@@ -109,8 +109,11 @@ def _derived() -> dict[str, str]:
     return {f"bayes-{s}": s for s in SIGNALS.names() if f"bayes-{s}" not in METHODS}
 
 
-def get_method(name: str) -> Method:
-    """The method called ``name``; ``bayes-<signal>`` for any registered signal."""
+def get_method(name: str, plugins: Iterable[str] = ()) -> Method:
+    """The method called ``name``; ``bayes-<signal>`` for any registered signal; ``plugins``:
+    files that may register it, loaded first."""
+    for path in plugins:
+        load_plugin(path)
     if name in METHODS:
         return METHODS.make(name)
     signal = _derived().get(name)
