@@ -8,9 +8,9 @@ costs an answer, "new scene", that tells little). Register your own in ``SCENE_D
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -20,8 +20,18 @@ from activeintent.learners.bayes.hypotheses import random_scene
 from activeintent.registry import Registry
 from activeintent.world import Scene
 
-if TYPE_CHECKING:  # the learner calls the design, not the other way round
-    from activeintent.learners.bayes.learner import BayesLearner
+
+class BeliefView(Protocol):
+    """What a design reads of the learner that calls it (the learner calls the design, not the
+    other way round): its settings, its random stream and its belief."""
+
+    config: Any  # n_scenes, scene_candidates, choose
+    rng: np.random.Generator
+    hyps: Sequence[Any]
+
+    @property
+    def weights(self) -> np.ndarray: ...
+
 
 @dataclass(frozen=True)
 class Design:
@@ -29,12 +39,12 @@ class Design:
     ``after_new_scene``: the learner designs the next scene after a "new scene" answer too
     (otherwise the protocol samples it)."""
 
-    candidates: Callable[[BayesLearner], Iterator[Scene]]
+    candidates: Callable[[BeliefView], Iterator[Scene]]
     after_new_scene: bool
     description: str
 
 
-def sampled_scenes(learner: BayesLearner) -> Iterator[Scene]:
+def sampled_scenes(learner: BeliefView) -> Iterator[Scene]:
     """``n_scenes`` random scenes (one for the random-query baseline), each followed in the
     learner's stream by its layout's draw."""
     c = learner.config
@@ -42,7 +52,7 @@ def sampled_scenes(learner: BayesLearner) -> Iterator[Scene]:
         yield random_scene(learner.rng)
 
 
-def belief_scenes(learner: BayesLearner) -> Iterator[Scene]:
+def belief_scenes(learner: BeliefView) -> Iterator[Scene]:
     """Each of ``scene_candidates`` candidates is a random scene that can show a z drawn from the
     belief (up to 20 draws); kept are the ``n_scenes`` that can show the most of the likely z
     (those holding 99 % of the belief, at most 64)."""
