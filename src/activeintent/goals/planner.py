@@ -36,9 +36,8 @@ from activeintent.world import (
     apply_skill,
     layout,
 )
-from activeintent.world.skills import skill_key
+from activeintent.world.skills import SIDES, skill_key
 
-SIDES = ("left", "right", "front", "behind")
 REGION_SPOTS = tuple(dict.fromkeys(p for r in REGIONS for p in region_points(r)[:1]))
 MAX_TRIES = 600  # candidate moves tried per plan
 

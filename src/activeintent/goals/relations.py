@@ -12,6 +12,7 @@ from activeintent.world import BLOCK_SIZE, PutIn, PutNextTo, PutOn
 from activeintent.world.colors import COLOR_NAMES, WARM_COLORS
 from activeintent.world.relations import table_position_name
 from activeintent.world.scene import ALL_OBJECTS, color_of, footprint_radius, kind_of, own_bowl
+from activeintent.world.skills import SIDES
 
 
 def _class(block_or_bowl: str) -> str:
@@ -168,10 +169,9 @@ class NextTo(Relation):
 
     def targets(self, state, b, p):
         return [PutNextTo(block=b, target=t, side=s) for t in self._targets(b, tuple(state.names), p)
-                for s in ("nearest", "left", "right", "front", "behind")]
+                for s in ("nearest", *SIDES)]
 
 
-SIDES = ("left", "right", "front", "behind")
 SIDE_WORDS = {"left": "left of", "right": "right of", "front": "in front of", "behind": "behind"}
 
 

@@ -30,7 +30,6 @@ from activeintent.goals.planning import GRID, free_points, nearest_points
 from activeintent.goals.relations import (
     REGIONS,
     SIDE_WORDS,
-    SIDES,
     Beside,
     InNamedBowl,
     NextTo,
@@ -52,6 +51,7 @@ from activeintent.goals.structures import (
 from activeintent.world import PutIn, PutNextTo, PutOn, Skill
 from activeintent.world.colors import COLOR_NAMES, COLORS
 from activeintent.world.scene import color_of, kind_of
+from activeintent.world.skills import SIDES
 
 VERSION = 2
 

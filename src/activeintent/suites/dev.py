@@ -71,11 +71,11 @@ from activeintent.world import (
     relations,
 )
 from activeintent.world.scene import ROW_PITCH, color_of
-from activeintent.world.skills import TABLE_POSITIONS
+from activeintent.world.skills import SIDES, TABLE_POSITIONS
 
 CENTRE = np.array([0.0, -0.5])
-CORNERS = ("top left corner", "top right corner", "bottom left corner", "bottom right corner")
-SIDES = ("nearest", "left", "right", "front", "behind")
+CELL_CORNERS = ("top left corner", "top right corner", "bottom left corner", "bottom right corner")
+NEXT_TO_SIDES = ("nearest", *SIDES)
 
 
 # --- scenes ------------------------------------------------------------------------------
@@ -166,7 +166,7 @@ def _first_ok(state: WorldState, steps: Iterable[Skill], accept: Callable[[World
 
 
 def _next_to_steps(block: str, target: str) -> list[Skill]:
-    return [PutNextTo(block=block, target=target, side=side) for side in SIDES]  # type: ignore[arg-type]
+    return [PutNextTo(block=block, target=target, side=side) for side in NEXT_TO_SIDES]  # type: ignore[arg-type]
 
 
 def _ring(state: WorldState, centre_of: str, radii: tuple[float, ...] = (0.097, 0.11, 0.125)) -> list[tuple[float, float]]:
@@ -345,7 +345,7 @@ class OneCorner(Intention):
         rel = relations(state)
         counts = self.counts(state, rel)
         centroid = np.mean([state.pos(b)[:2] for b in state.blocks], axis=0)
-        order = sorted(CORNERS, key=lambda c: (-counts[c], float(np.hypot(*(np.array(TABLE_POSITIONS[c]) - centroid)))))
+        order = sorted(CELL_CORNERS, key=lambda c: (-counts[c], float(np.hypot(*(np.array(TABLE_POSITIONS[c]) - centroid)))))
 
         def into(corner: str) -> Callable[[WorldState, str], Skill | None]:
             def place(current: WorldState, block: str) -> Skill | None:

@@ -15,7 +15,6 @@ from __future__ import annotations
 import errno
 import logging
 import time
-from collections import Counter
 from collections.abc import Callable
 from typing import Any
 
@@ -24,6 +23,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
+from activeintent.memo import BoundedCache
 from activeintent.signals import AnswerRejected
 
 log = logging.getLogger("activeintent.web")
@@ -44,28 +44,46 @@ DEFAULT_CODES = {
 }
 
 
+class RepeatGate:
+    """One line of each kind per ``every`` seconds: :meth:`admit` says whether this one passes and,
+    when it does, what to add to it about those held back since the last. It remembers the last
+    ``size`` kinds (a forgotten kind passes again)."""
+
+    def __init__(self, every: float = 10.0, clock: Callable[[], float] = time.monotonic, size: int = 256):
+        self.every, self.clock = every, clock
+        self._last: BoundedCache[str, float] = BoundedCache(size)
+        self._held: BoundedCache[str, int] = BoundedCache(size)
+
+    def admit(self, kind: str) -> str | None:
+        """None: held back; else the note for the line ('' when none was held back)."""
+        now = self.clock()
+        last = self._last.get(kind)
+        if last is not None and now - last < self.every:
+            self._held.put(kind, (self._held.get(kind) or 0) + 1)
+            return None
+        held = self._held.get(kind) or 0
+        self._held.put(kind, 0)
+        self._last.put(kind, now)
+        if not held:
+            return ""
+        since = f" in the last {now - last:.0f} s" if last is not None else ""
+        return f" (and {held} more like it{since})"
+
+
 class RateLimitedLog:
     """At most one line per ``every`` seconds of each kind, the next one saying how many were
     left out: what a flood of bad connections makes the server say stays a few lines."""
 
     def __init__(self, logger: logging.Logger, every: float = 10.0, clock: Callable[[], float] = time.monotonic):
-        self.logger, self.every, self.clock = logger, every, clock
-        self._last: dict[str, float] = {}
-        self._skipped: Counter[str] = Counter()
+        self.logger = logger
+        self.gate = RepeatGate(every, clock)
 
     def warning(self, kind: str, message: str, *args: Any) -> bool:
         """Log ``message % args`` unless a line of ``kind`` was logged less than ``every`` s ago."""
-        now = self.clock()
-        last = self._last.get(kind)
-        if last is not None and now - last < self.every:
-            self._skipped[kind] += 1
+        note = self.gate.admit(kind)
+        if note is None:
             return False
-        skipped = self._skipped.pop(kind, 0)
-        if skipped:
-            message += " (and %d more like it in the last %.0f s)"
-            args = (*args, skipped, now - last)
-        self._last[kind] = now
-        self.logger.warning(message, *args)
+        self.logger.warning(message + note.replace("%", "%%"), *args)
         return True
 
 

@@ -35,8 +35,7 @@ import uvicorn
 from starlette.types import ASGIApp, Receive, Scope, Send
 from uvicorn.protocols.http.h11_impl import H11Protocol
 
-from activeintent.memo import BoundedCache
-from activeintent.web.errors import RateLimitedLog, error_body
+from activeintent.web.errors import RateLimitedLog, RepeatGate, error_body
 
 log = logging.getLogger("activeintent.web")
 
@@ -279,23 +278,14 @@ class QuietRepeats(logging.Filter):
 
     def __init__(self, every: float = 10.0, clock=time.monotonic):
         super().__init__()
-        self.every, self.clock = every, clock
-        # when each message last passed, by its first 200 characters; messages are templates, but
-        # the memory is bounded anyway (a forgotten message passes again)
-        self._last: BoundedCache[str, float] = BoundedCache(256)
-        self._skipped: Counter[str] = Counter()
+        self.gate = RepeatGate(every, clock)  # by a message's first 200 characters (messages are templates)
 
     def filter(self, record: logging.LogRecord) -> bool:
-        key = str(record.msg)[:200]
-        now = self.clock()
-        last = self._last.get(key)
-        if last is not None and now - last < self.every:
-            self._skipped[key] += 1
+        note = self.gate.admit(str(record.msg)[:200])
+        if note is None:
             return False
-        self._last.put(key, now)
-        skipped = self._skipped.pop(key, 0)
-        if skipped:
-            record.msg = f"{record.msg} (and {skipped} more like it in the last {now - last:.0f} s)"
+        if note:
+            record.msg = f"{record.msg}{note}"
         return True
 
 

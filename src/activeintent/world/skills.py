@@ -11,6 +11,7 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, Field
 
 Side = Literal["left", "right", "front", "behind", "nearest"]
+SIDES = ("left", "right", "front", "behind")  # the sides of an object PutNextTo names (besides "nearest")
 
 # Named table positions (Code-as-Policies): corners, sides and the middle.
 TABLE_POSITIONS: dict[str, tuple[float, float]] = {
