@@ -539,7 +539,24 @@ class OneBowl(Structure):
         return [PutIn(block=b, bowl=w) for w in bowls for b in g]
 
 
-class SeparateBowls(Structure):
+class EachBlock(Structure):
+    """A structure each block of the group meets on its own (``block_ok``): it holds when all
+    do, scores the share that do, and a move is fine when the moved block does."""
+
+    def block_ok(self, f: Facts, g: Group, b: str) -> bool:
+        raise NotImplementedError
+
+    def holds(self, f, g, p):
+        return all(self.block_ok(f, g, b) for b in g)
+
+    def score(self, f, g, p):
+        return sum(self.block_ok(f, g, b) for b in g) / len(g)
+
+    def moved_ok(self, fb, fa, g, b, p):
+        return self.block_ok(fa, g, b)
+
+
+class SeparateBowls(EachBlock):
     key = "separate-bowls"
     min_size = 1
 
@@ -559,15 +576,6 @@ class SeparateBowls(Structure):
         if self.at_most != 1:
             return w is not None and sum(f.bowl_of[o] == w for o in g) <= self.at_most
         return w is not None and not any(o != b and f.bowl_of[o] == w for o in g)
-
-    def holds(self, f, g, p):
-        return all(self.block_ok(f, g, b) for b in g)
-
-    def score(self, f, g, p):
-        return sum(self.block_ok(f, g, b) for b in g) / len(g)
-
-    def moved_ok(self, fb, fa, g, b, p):
-        return self.block_ok(fa, g, b)
 
     def possible(self, g, objects, p):
         return 1 <= len(g) <= self.at_most * sum(kind_of(o) == "bowl" for o in objects)
@@ -630,7 +638,7 @@ class Cluster(Structure):
 CORNERS = ("back left corner", "back right corner", "front left corner", "front right corner")
 
 
-class Corners(Structure):
+class Corners(EachBlock):
     key = "corners"
     min_size = 1
 
@@ -645,15 +653,6 @@ class Corners(Structure):
     def block_ok(self, f, g, b):
         c = self.corner(f, b)
         return c is not None and all(self.corner(f, o) != c for o in g if o != b)
-
-    def holds(self, f, g, p):
-        return all(self.block_ok(f, g, b) for b in g)
-
-    def score(self, f, g, p):
-        return sum(self.block_ok(f, g, b) for b in g) / len(g)
-
-    def moved_ok(self, fb, fa, g, b, p):
-        return self.block_ok(fa, g, b)
 
     def possible(self, g, objects, p):
         return 1 <= len(g) <= 4
