@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 from activeintent.cli import app
 from activeintent.protocol import trial_seeds
 from activeintent.results import hold_results_folder, load_results, read_results
-from activeintent.spec import EpisodeSeeds
+from activeintent.spec import EpisodeSeeds, RunSpec
 
 TINY = ["--no-oracle", "--methods", "zero-signal", "--intentions", "color-match", "--budget", "2", "--test-scenes", "2",
         "--test-pool", "0", "--env", "symbolic", "--llm", "none", "--seed", "3"]
@@ -147,3 +147,21 @@ def test_removing_the_lock_file_does_not_let_a_second_bench_in(tmp_path):
     assert len(keys) == len(set(keys))
     with hold_results_folder(tmp_path):  # released with the killed holder
         pass
+
+
+def test_a_record_of_the_older_shape_equal_to_the_rerun_is_the_one_kept(tmp_path):
+    """Duplicates are settled as bench-verify compares: a record written before the spec was kept
+    whole (flat options, settings repeated at its top) is read in today's shape first."""
+    bench(tmp_path, 1)
+    results = tmp_path / "results.jsonl"
+    real = json.loads(results.read_bytes())
+    options = {k: v for k, v in RunSpec.model_validate(real["config"]["spec"]).options().items() if k != "plugin"}
+    old = {**{k: v for k, v in real.items() if k != "config"}, "user_preset": "human", "prior": "length",
+           "llm": "none", "vlm": None, "executor": "plan", "retriever": "symbolic", "variant": "faithful",
+           "config": {"episode": real["config"]["episode"], "options": {**options, "plugins": []}}}
+    old_bytes = json.dumps(old).encode() + b"\n"
+    forged = {**old, "success": 1.0, "success_at": [1.0, 1.0, 1.0]}
+    results.write_bytes(json.dumps(forged).encode() + b"\n" + old_bytes)
+    res = bench(tmp_path, 1)
+    assert "another one equals the episode run again" in " ".join(res.output.split())
+    assert results.read_bytes() == old_bytes

@@ -26,6 +26,7 @@ from pathlib import Path
 
 from activeintent.bench.backends import execute_ray, worker_died
 from activeintent.bench.checks import Plan
+from activeintent.bench.legacy import migrated
 from activeintent.bench.verify import differences
 from activeintent.bench.work import (
     BenchConfig,
@@ -101,7 +102,7 @@ def _settle_duplicate(path: Path, again: dict, cands: list[Candidate]) -> tuple[
     the re-run's record takes their place. Set aside first, then the file rewritten at once: a
     kill in between leaves the duplicates in place, to be settled by the next resume."""
     plain = json.loads(dumps(again))  # as it would be read back
-    winner = next((c for c in cands if not again.get("error") and not differences(c.record, plain)), None)
+    winner = next((c for c in cands if not again.get("error") and not differences(migrated(c.record), plain)), None)
     losers = [c for c in cands if c is not winner]
     aside = [Rejected(line=c.line, kind="duplicate", text=c.raw.decode("utf-8", "backslashreplace"),
                       reason=(f"one of {len(cands)} records of {c.key[0]} / {c.key[1]} / trial {c.key[2]}: "

@@ -97,7 +97,7 @@ def bench(
             given["budget"] = PRESETS[preset]["budget"]
             trials = trials or preset_trials
         trials = trials or 20
-        run = opt.run_spec(**given, video="none")
+        run = RunSpec.from_options(**given, video="none")
         method_list = _split(methods) or ["bayes-preference", "bayes-stop", "zero-signal", "random-query"]
         for m in method_list:
             check_spec(for_method(run, m))

@@ -18,7 +18,7 @@ from pydantic.fields import FieldInfo
 from pydantic_core import PydanticUndefined
 
 from activeintent.learners.registry import get_method, method_names
-from activeintent.spec import RunSpec, option_fields
+from activeintent.spec import option_fields
 from activeintent.web.basics import parse_video_size
 
 
@@ -147,11 +147,6 @@ class SpecCommand:
 def spec_command(exclude: tuple[str, ...] = ()) -> Callable[[Callable[..., Any]], SpecCommand]:
     """Decorator: the command takes the spec's options (but ``exclude``), see :class:`SpecCommand`."""
     return lambda func: SpecCommand(func, frozenset(exclude))
-
-
-def run_spec(**values: Any) -> RunSpec:
-    """The run's spec from option values; a bad value becomes a message naming the option."""
-    return RunSpec.from_options(**values)
 
 
 def _video_size(text: str) -> tuple[int, int]:

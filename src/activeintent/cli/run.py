@@ -13,6 +13,7 @@ from activeintent.llm.base import ModelError
 from activeintent.progress_lines import Eta, print_line
 from activeintent.runner import DEFAULT_INTENTION, build_episode, check_spec
 from activeintent.signals import answer_kind_from_dump
+from activeintent.spec import RunSpec
 from activeintent.suites import resolve
 
 
@@ -142,7 +143,7 @@ def run(
     if unsafe_no_isolation:
         allow_unsafe_no_isolation()
     try:
-        spec = opt.run_spec(**given)
+        spec = RunSpec.from_options(**given)
     except ValueError as err:
         console.print(f"[red]error:[/red] {escape(str(err))}", soft_wrap=True)
         raise typer.Exit(2) from None

@@ -14,6 +14,7 @@ from activeintent.intentions.registry import IntentionError
 from activeintent.learners.registry import get_method
 from activeintent.protocol import DEFAULT_BUDGET
 from activeintent.runner import check_spec
+from activeintent.spec import RunSpec
 from activeintent.suites import resolve as resolve_intention
 from activeintent.web.basics import VIDEO_SIZE_TEXT
 from activeintent.web.export import collect_sessions, corpus_rows, write_table
@@ -100,7 +101,7 @@ def serve(
         try:
             models[name] = llm or ("embedded" if get_method(m).needs_llm else "none")
             # the spec and the assigned rule are checked now so a typo fails before anyone opens the page
-            run = opt.run_spec(method=m, budget=rounds, intention=rule_name, intention_file=rule_file,
+            run = RunSpec.from_options(method=m, budget=rounds, intention=rule_name, intention_file=rule_file,
                                llm=models[name], seed=seed, **extra)
             check_spec(run)
             rule = resolve_intention(rule_name, rule_file) if rule_name or rule_file else None
